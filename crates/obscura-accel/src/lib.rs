@@ -1,0 +1,1 @@
+//! obscura-accel: under construction.

@@ -1,0 +1,1 @@
+//! obscura-camera: under construction.

@@ -1,0 +1,1 @@
+//! obscura-sample: under construction.

@@ -1,0 +1,1 @@
+//! obscura-shade: under construction.

@@ -1,0 +1,2 @@
+//! Obscura: camera models for ray tracing.
+pub use obscura_space as space;
