@@ -1,0 +1,300 @@
+//! The public sampler: which generator, how many samples per pixel, which seed, and the
+//! per-sample cursor over dimensions.
+
+use std::fmt;
+use std::str::FromStr;
+
+use glam::Vec2;
+
+use crate::error::SampleError;
+use crate::hash::pixel_key;
+use crate::sequences;
+
+/// The largest number of samples per pixel: `2^24`, so that every stratum of every
+/// generator still holds an `f32` and stratification survives rounding.
+pub const MAX_SAMPLES_PER_PIXEL: u32 = 1 << 24;
+
+/// The four sample generators of the scene format's `[sampler] type`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum SamplerKind {
+    /// `"independent"`: uniform random values, no stratification (PCG32 per sample).
+    Independent,
+    /// `"stratified"`: multi-jittered strata per pair of dimensions, pairs shuffled
+    /// independently per pixel.
+    Stratified,
+    /// `"halton"`: the Halton sequence in prime bases with random digit permutations per
+    /// pixel and dimension.
+    Halton,
+    /// `"sobol"`: padded 2D Sobol (0,2)-sequences with hash-based Owen scrambling.
+    Sobol,
+}
+
+impl SamplerKind {
+    /// All kinds, in the order of the scene format.
+    pub const ALL: [SamplerKind; 4] = [
+        SamplerKind::Independent,
+        SamplerKind::Stratified,
+        SamplerKind::Halton,
+        SamplerKind::Sobol,
+    ];
+
+    /// The name used in scene files: `"independent"`, `"stratified"`, `"halton"`, `"sobol"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            SamplerKind::Independent => "independent",
+            SamplerKind::Stratified => "stratified",
+            SamplerKind::Halton => "halton",
+            SamplerKind::Sobol => "sobol",
+        }
+    }
+}
+
+impl fmt::Display for SamplerKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for SamplerKind {
+    type Err = SampleError;
+
+    /// Parses exactly the names of [`SamplerKind::name`] (lower case).
+    fn from_str(name: &str) -> Result<SamplerKind, SampleError> {
+        SamplerKind::ALL
+            .into_iter()
+            .find(|kind| kind.name() == name)
+            .ok_or_else(|| SampleError::UnknownSampler {
+                name: name.to_owned(),
+            })
+    }
+}
+
+/// A configured sampler: kind, samples per pixel and seed. Cheap to clone and to share
+/// between threads; it holds no mutable state.
+///
+/// Every value is a pure function of (pixel, sample index, dimension, seed), so a render is
+/// the same for any number of threads and any tile order. Dimensions 0-1 are the film offset
+/// inside the pixel, 2-3 the lens, 4 the time; shading takes 5 and up through
+/// [`SampleStream`]. Dimensions are generated in pairs `(2p, 2p + 1)`: the stratified and
+/// Sobol samplers stratify each pair jointly, and every pair is decorrelated from every
+/// other pair per pixel.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Sampler {
+    kind: SamplerKind,
+    samples_per_pixel: u32,
+    seed: u64,
+    grid: [u32; 2],
+}
+
+impl Sampler {
+    /// A sampler of `kind` with `samples_per_pixel` samples (1 to
+    /// [`MAX_SAMPLES_PER_PIXEL`]) and `seed`.
+    pub fn new(
+        kind: SamplerKind,
+        samples_per_pixel: u32,
+        seed: u64,
+    ) -> Result<Sampler, SampleError> {
+        if samples_per_pixel == 0 {
+            return Err(SampleError::ZeroSamplesPerPixel);
+        }
+        if samples_per_pixel > MAX_SAMPLES_PER_PIXEL {
+            return Err(SampleError::TooManySamplesPerPixel {
+                spp: samples_per_pixel,
+                max: MAX_SAMPLES_PER_PIXEL,
+            });
+        }
+        Ok(Sampler {
+            kind,
+            samples_per_pixel,
+            seed,
+            grid: sequences::stratified_grid(samples_per_pixel),
+        })
+    }
+
+    /// Which generator this is.
+    pub fn kind(&self) -> SamplerKind {
+        self.kind
+    }
+
+    /// Samples per pixel.
+    pub fn samples_per_pixel(&self) -> u32 {
+        self.samples_per_pixel
+    }
+
+    /// The seed.
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    /// The stratified sampler's 2D grid `[nx, ny]` per pair of dimensions: `nx * ny` equals
+    /// the samples per pixel, `nx` is its largest divisor not above its square root.
+    pub fn stratified_grid(&self) -> [u32; 2] {
+        self.grid
+    }
+
+    /// The value of `dimension` of sample `index` of `pixel`, in `[0, 1)`.
+    ///
+    /// Pure function of (pixel, index, dimension, seed). Indices at or beyond
+    /// [`Sampler::samples_per_pixel`] are valid: the stratified sampler starts a fresh,
+    /// independently shuffled pattern every `samples_per_pixel` indices, and the sequences
+    /// simply continue.
+    #[inline]
+    pub fn value(&self, pixel: [u32; 2], index: u32, dimension: u32) -> f32 {
+        self.value_keyed(pixel_key(self.seed, pixel), index, dimension)
+    }
+
+    /// [`Sampler::value`] with the pixel's key already hashed.
+    #[inline]
+    fn value_keyed(&self, pixel_key: u64, index: u32, dimension: u32) -> f32 {
+        match self.kind {
+            SamplerKind::Independent => {
+                sequences::independent(pixel_key, self.seed, index, dimension)
+            }
+            SamplerKind::Stratified => sequences::stratified(
+                pixel_key,
+                self.samples_per_pixel,
+                self.grid,
+                index,
+                dimension,
+            ),
+            SamplerKind::Halton => sequences::halton(pixel_key, index, dimension),
+            SamplerKind::Sobol => sequences::sobol(pixel_key, index, dimension),
+        }
+    }
+
+    /// A cursor over the dimensions of sample `index` of `pixel`. No heap allocation.
+    #[inline]
+    pub fn stream(&self, pixel: [u32; 2], index: u32) -> SampleStream<'_> {
+        SampleStream {
+            sampler: self,
+            pixel_key: pixel_key(self.seed, pixel),
+            index,
+            dimension: 0,
+        }
+    }
+}
+
+/// The camera's share of one sample: where in the pixel, where on the lens, when.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CameraDims {
+    /// Offset inside the pixel, in `[0, 1)^2` (dimensions 0 and 1): the raster position is
+    /// `pixel + film`.
+    pub film: glam::Vec2,
+    /// Lens sample in `[0, 1)^2` (dimensions 2 and 3), to be warped to the aperture, e.g. by
+    /// [`crate::square_to_concentric_disk`].
+    pub lens: glam::Vec2,
+    /// Normalised shutter time in `[0, 1)` (dimension 4), to be mapped by
+    /// [`crate::shutter_time`], optionally through a [`crate::ShutterCurve`].
+    pub time: f32,
+}
+
+/// A cursor over the dimensions of one sample, from [`Sampler::stream`].
+///
+/// Layout: [`SampleStream::camera`] takes dimensions 0-4 (film 0-1, lens 2-3, time 4); then
+/// [`SampleStream::next_1d`] takes the next dimension and [`SampleStream::next_2d`] the next
+/// aligned pair `(2p, 2p + 1)`, skipping one dimension if the cursor is odd, so a 2D request
+/// always gets a pair that the stratified and Sobol samplers stratify jointly. So after
+/// `camera()`, `next_2d()` reads dimensions 6-7, while `next_1d()` would read 5.
+#[derive(Debug, Clone)]
+pub struct SampleStream<'a> {
+    sampler: &'a Sampler,
+    pixel_key: u64,
+    index: u32,
+    dimension: u32,
+}
+
+impl SampleStream<'_> {
+    /// The camera dimensions 0-4. Meant as the first call; called later it still returns
+    /// dimensions 0-4 and moves the cursor to at least 5.
+    #[inline]
+    pub fn camera(&mut self) -> CameraDims {
+        let value = |dimension| {
+            self.sampler
+                .value_keyed(self.pixel_key, self.index, dimension)
+        };
+        let dims = CameraDims {
+            film: Vec2::new(value(0), value(1)),
+            lens: Vec2::new(value(2), value(3)),
+            time: value(4),
+        };
+        self.dimension = self.dimension.max(5);
+        dims
+    }
+
+    /// The next dimension, in `[0, 1)`.
+    #[inline]
+    pub fn next_1d(&mut self) -> f32 {
+        let u = self
+            .sampler
+            .value_keyed(self.pixel_key, self.index, self.dimension);
+        self.dimension = self.dimension.saturating_add(1);
+        u
+    }
+
+    /// The next aligned pair of dimensions, in `[0, 1)^2`.
+    #[inline]
+    pub fn next_2d(&mut self) -> Vec2 {
+        let first = self.dimension.saturating_add(self.dimension % 2);
+        let u2 = Vec2::new(
+            self.sampler.value_keyed(self.pixel_key, self.index, first),
+            self.sampler
+                .value_keyed(self.pixel_key, self.index, first.saturating_add(1)),
+        );
+        self.dimension = first.saturating_add(2);
+        u2
+    }
+
+    /// The dimension the next [`SampleStream::next_1d`] will read.
+    pub fn dimension(&self) -> u32 {
+        self.dimension
+    }
+
+    /// The sample index this stream reads.
+    pub fn index(&self) -> u32 {
+        self.index
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip() {
+        for kind in SamplerKind::ALL {
+            assert_eq!(kind.name().parse::<SamplerKind>(), Ok(kind));
+        }
+        assert_eq!("sobol".parse::<SamplerKind>(), Ok(SamplerKind::Sobol));
+        assert!(matches!(
+            "Sobol".parse::<SamplerKind>(),
+            Err(SampleError::UnknownSampler { name }) if name == "Sobol"
+        ));
+    }
+
+    #[test]
+    fn rejects_bad_sample_counts() {
+        assert_eq!(
+            Sampler::new(SamplerKind::Sobol, 0, 0),
+            Err(SampleError::ZeroSamplesPerPixel)
+        );
+        assert!(Sampler::new(SamplerKind::Halton, MAX_SAMPLES_PER_PIXEL + 1, 0).is_err());
+        assert!(Sampler::new(SamplerKind::Halton, MAX_SAMPLES_PER_PIXEL, 0).is_ok());
+    }
+
+    #[test]
+    fn stream_layout_matches_value() {
+        let sampler = Sampler::new(SamplerKind::Stratified, 16, 7).unwrap();
+        let mut stream = sampler.stream([3, 4], 5);
+        let dims = stream.camera();
+        let v = |d| sampler.value([3, 4], 5, d);
+        assert_eq!(dims.film, Vec2::new(v(0), v(1)));
+        assert_eq!(dims.lens, Vec2::new(v(2), v(3)));
+        assert_eq!(dims.time, v(4));
+        // After the camera, next_2d skips dimension 5 and reads the pair (6, 7).
+        assert_eq!(stream.next_2d(), Vec2::new(v(6), v(7)));
+        assert_eq!(stream.next_1d(), v(8));
+        // Cursor at 9 (odd): next_2d pads to (10, 11).
+        assert_eq!(stream.next_2d(), Vec2::new(v(10), v(11)));
+        assert_eq!(stream.dimension(), 12);
+    }
+}

@@ -1,0 +1,260 @@
+//! The four sample generators, each a pure function of (pixel key, sample index, dimension).
+//!
+//! The pixel key is [`crate::hash::pixel_key`] of (seed, pixel); everything else that varies
+//! per pixel, per dimension or per pair of dimensions is hashed from it here.
+
+use rand_core::Rng;
+use rand_pcg::Pcg32;
+
+use crate::hash::{
+    combine, in_stratum, mix64, owen_scramble, permute, unit_f32_from_bits, unit_f64_from_bits,
+};
+
+/// Tags that keep the hash streams of the samplers and of their parts apart.
+const TAG_STRATIFIED: u64 = 0x5354_5241_5449_4659;
+const TAG_HALTON: u64 = 0x4841_4c54_4f4e_0001;
+const TAG_HALTON_JITTER: u64 = 0x4841_4c54_4f4e_0002;
+const TAG_SOBOL: u64 = 0x534f_424f_4c00_0001;
+
+/// The finest strata a value is placed in: `2^24`, one `f32` ulp just below one.
+const MAX_STRATA: u32 = 1 << 24;
+
+// ---------------------------------------------------------------------------------------
+// Independent
+
+/// Independent uniform values: a PCG32 generator seeded per (pixel, index, seed), advanced
+/// by `dimension` steps (PCG jumps ahead in logarithmic time), so the value does not depend
+/// on which dimensions were asked for before.
+#[inline]
+pub(crate) fn independent(pixel_key: u64, seed: u64, index: u32, dimension: u32) -> f32 {
+    let state = combine(pixel_key, u64::from(index));
+    let stream = mix64(seed ^ 0x1d8e_4e27_c47d_124f);
+    let mut rng = Pcg32::new(state, stream);
+    rng.advance(u64::from(dimension));
+    unit_f32_from_bits(rng.next_u32())
+}
+
+// ---------------------------------------------------------------------------------------
+// Stratified
+
+/// The 2D grid `[nx, ny]` used for `spp` samples: the factorisation `nx * ny = spp` with `nx`
+/// the largest divisor of `spp` not above its square root (so `nx <= ny`; a prime `spp` gives
+/// `1 x spp`).
+pub(crate) fn stratified_grid(spp: u32) -> [u32; 2] {
+    let mut nx = spp.isqrt().max(1);
+    while spp % nx != 0 {
+        nx -= 1;
+    }
+    [nx, spp / nx]
+}
+
+/// Multi-jittered stratified sampling (Chiu, Shirley and Wang 1994) per pair of dimensions.
+///
+/// The samples `pass * spp .. (pass + 1) * spp` of a pixel form one pattern. For pair `p`
+/// (dimensions `2p`, `2p + 1`), sample `index` first takes a shuffled 2D cell
+/// `s = permute(index % spp)`, with a permutation drawn per (pixel, pair, pass): that shuffle
+/// is what decorrelates the lens and time strata from the film strata. Cell `s` is column
+/// `i = s % nx`, row `j = s / nx`. The x value then sits in the fine stratum
+/// `i * ny + perm_i(j)` of `spp`, the y value in `j * nx + perm_j(i)`, with fresh
+/// permutations per column and row, and a jitter inside. So every pattern is jittered on the
+/// `nx x ny` grid AND each dimension alone is stratified into `spp` equal intervals
+/// (Latin hypercube), whatever `spp` is.
+#[inline]
+pub(crate) fn stratified(
+    pixel_key: u64,
+    spp: u32,
+    grid: [u32; 2],
+    index: u32,
+    dimension: u32,
+) -> f32 {
+    let [nx, ny] = grid;
+    let pass = index / spp;
+    let pair = dimension / 2;
+    let pattern_key = combine(
+        combine(combine(pixel_key, TAG_STRATIFIED), u64::from(pair)),
+        u64::from(pass),
+    );
+    // Shuffle the cells per pair: the pair's stratum does not follow the film's.
+    let s = permute(index % spp, spp, pattern_key);
+    let i = s % nx;
+    let j = s / nx;
+    // Fine stratum within the column (x) or row (y), and a jitter inside it.
+    let (fine, component_key) = if dimension % 2 == 0 {
+        let key = combine(pattern_key, 2 * u64::from(i));
+        (i * ny + permute(j, ny, key), key)
+    } else {
+        let key = combine(pattern_key, 2 * u64::from(j) + 1);
+        (j * nx + permute(i, nx, key), key)
+    };
+    let jitter = unit_f64_from_bits(combine(component_key, u64::from(s) | (1 << 40)));
+    in_stratum(fine, spp, jitter)
+}
+
+// ---------------------------------------------------------------------------------------
+// Halton
+
+/// How many dimensions get their own prime base; dimension `d` uses `PRIMES[d % NUM_PRIMES]`
+/// (beyond that the bases repeat, with independent scrambles).
+pub(crate) const NUM_PRIMES: usize = 1024;
+
+/// The first [`NUM_PRIMES`] primes, found at compile time by trial division.
+pub(crate) static PRIMES: [u32; NUM_PRIMES] = first_primes();
+
+const fn first_primes() -> [u32; NUM_PRIMES] {
+    let mut primes = [0u32; NUM_PRIMES];
+    let mut count = 0;
+    let mut candidate = 2u32;
+    while count < NUM_PRIMES {
+        let mut is_prime = true;
+        let mut k = 0;
+        while k < count && primes[k] * primes[k] <= candidate {
+            if candidate % primes[k] == 0 {
+                is_prime = false;
+                break;
+            }
+            k += 1;
+        }
+        if is_prime {
+            primes[count] = candidate;
+            count += 1;
+        }
+        candidate += 1;
+    }
+    primes
+}
+
+/// The scrambled radical inverse of `index` in the prime base of `dimension`.
+///
+/// The first `K` base-`b` digits (with `b^K <= 2^24`) are each sent through a random
+/// permutation of `0..b` drawn per (seed, pixel, dimension, digit position) (random digit
+/// permutation scrambling; in base 2 a random xor). The permuted digits name one of `b^K`
+/// fine strata and a hashed jitter places the value inside it (standing in for the infinite
+/// tail of scrambled digits). Digit-wise bijections map the set of `k`-digit prefixes of
+/// indices `0..b^k` onto itself, so the scrambled points keep the stratification of the
+/// Halton sequence: the first `b^k` indices fill each interval `[m / b^k, (m + 1) / b^k)`
+/// once, and pairs of dimensions fill `b1^k1 x b2^k2` grids.
+#[inline]
+pub(crate) fn halton(pixel_key: u64, index: u32, dimension: u32) -> f32 {
+    let base = PRIMES[dimension as usize % NUM_PRIMES];
+    let key = combine(combine(pixel_key, TAG_HALTON), u64::from(dimension));
+    let (stratum, count) = if base == 2 {
+        // All 24 binary digits at once: bit reversal, then xor with random bits.
+        let digits = index.reverse_bits() >> 8;
+        (digits ^ ((key as u32) >> 8), MAX_STRATA)
+    } else {
+        let mut stratum = 0u32;
+        let mut count = 1u32;
+        let mut rest = index;
+        let mut position = 0u64;
+        while count <= MAX_STRATA / base {
+            let digit = rest % base;
+            rest /= base;
+            stratum = stratum * base + permute(digit, base, combine(key, position));
+            count *= base;
+            position += 1;
+        }
+        (stratum, count)
+    };
+    let jitter = unit_f64_from_bits(combine(combine(key, TAG_HALTON_JITTER), u64::from(index)));
+    in_stratum(stratum, count, jitter)
+}
+
+// ---------------------------------------------------------------------------------------
+// Sobol
+
+/// The second dimension of the Sobol sequence as a 32-bit binary fraction: its generator
+/// matrix is Pascal's triangle modulo 2, whose successive columns `v` are obtained by
+/// `v ^= v >> 1` from `v = 1 << 31`.
+#[inline]
+pub(crate) fn sobol_second(mut index: u32) -> u32 {
+    let mut result = 0u32;
+    let mut column = 1u32 << 31;
+    while index != 0 {
+        if index & 1 != 0 {
+            result ^= column;
+        }
+        index >>= 1;
+        column ^= column >> 1;
+    }
+    result
+}
+
+/// Padded, Owen-scrambled Sobol: each pair of dimensions `(2p, 2p + 1)` is the 2D
+/// (0,2)-sequence (van der Corput, second Sobol dimension), its sample index shuffled per
+/// (pixel, pair) and each coordinate Owen-scrambled per (pixel, pair, coordinate).
+///
+/// The index shuffle is itself a nested uniform scramble of the index bits, which maps the
+/// indices `0..2^m` onto an aligned block of `2^m` indices: those are again a (0,m,2)-net, and
+/// Owen scrambling keeps nets, so every pair of dimensions of the first `2^m` samples puts
+/// exactly one point in each elementary interval of area `2^-m`.
+#[inline]
+pub(crate) fn sobol(pixel_key: u64, index: u32, dimension: u32) -> f32 {
+    let pair = dimension / 2;
+    let pair_key = combine(combine(pixel_key, TAG_SOBOL), u64::from(pair));
+    let shuffled = owen_scramble(index, pair_key as u32);
+    let raw = if dimension % 2 == 0 {
+        shuffled.reverse_bits()
+    } else {
+        sobol_second(shuffled)
+    };
+    let scramble_seed = combine(pair_key, u64::from(dimension % 2) + 1) as u32;
+    unit_f32_from_bits(owen_scramble(raw, scramble_seed))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn primes_start_right_and_are_prime() {
+        assert_eq!(&PRIMES[..10], &[2, 3, 5, 7, 11, 13, 17, 19, 23, 29]);
+        // The 1024th prime is 8161.
+        assert_eq!(PRIMES[NUM_PRIMES - 1], 8161);
+        for &p in &PRIMES {
+            assert!((2..p).take_while(|d| d * d <= p).all(|d| p % d != 0), "{p}");
+        }
+    }
+
+    #[test]
+    fn grid_hand_cases() {
+        assert_eq!(stratified_grid(1), [1, 1]);
+        assert_eq!(stratified_grid(16), [4, 4]);
+        assert_eq!(stratified_grid(12), [3, 4]);
+        assert_eq!(stratified_grid(8), [2, 4]);
+        assert_eq!(stratified_grid(7), [1, 7]);
+    }
+
+    #[test]
+    fn sobol_second_first_points() {
+        // Index 1: column 0 = 1000... -> 0.5. Index 2: column 1 = 1100... -> 0.75.
+        // Index 3: 1000... ^ 1100... = 0100... -> 0.25. Index 4: column 2 = 1010... -> 0.625.
+        let as_fraction = |i| f64::from(sobol_second(i)) / 2f64.powi(32);
+        assert_eq!(as_fraction(0), 0.0);
+        assert_eq!(as_fraction(1), 0.5);
+        assert_eq!(as_fraction(2), 0.75);
+        assert_eq!(as_fraction(3), 0.25);
+        assert_eq!(as_fraction(4), 0.625);
+    }
+
+    /// The first `count` binary digits of a 32-bit fraction.
+    fn top_bits(v: u32, count: u32) -> u32 {
+        if count == 0 { 0 } else { v >> (32 - count) }
+    }
+
+    #[test]
+    fn unscrambled_sobol_pair_is_a_02_sequence() {
+        // Every elementary interval of area 2^-m holds one of the first 2^m points.
+        for m in 0..=10u32 {
+            for a in 0..=m {
+                let mut seen = vec![false; 1 << m];
+                for i in 0..(1u32 << m) {
+                    let x = top_bits(i.reverse_bits(), a);
+                    let y = top_bits(sobol_second(i), m - a);
+                    let cell = ((x << (m - a)) | y) as usize;
+                    assert!(!seen[cell], "m = {m}, a = {a}: cell {cell} twice");
+                    seen[cell] = true;
+                }
+            }
+        }
+    }
+}
