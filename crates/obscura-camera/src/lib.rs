@@ -1,1 +1,71 @@
-//! obscura-camera: under construction.
+//! Camera models for ray tracing: orthographic and perspective projection, each with an
+//! optional thin lens (depth of field), the 360-degree environment camera, and camera motion
+//! over an open shutter.
+//!
+//! A camera turns a [`CameraSample`] (a film position in raster space, a lens sample and a time
+//! sample, all filled in by a sampler) into a world-space [`CameraRay`] with a unit direction,
+//! a time and a visible `[t_min, t_max]`; [`Camera::project`] is the inverse, a world point to
+//! its raster position. The models are [`PerspectiveCamera`], [`OrthographicCamera`] and
+//! [`EnvironmentCamera`], gathered in [`AnyCamera`]; they share a [`CameraBase`] (pose,
+//! [`Shutter`], [`FilmGeometry`], clip range) and, for the projective two, a
+//! [`ProjectiveCamera`] holding the chain camera -> screen -> NDC -> raster as typed
+//! transforms (`screen_from_camera`, `raster_from_screen`, `camera_from_raster`...). Errors are
+//! [`CameraError`].
+//!
+//! What is not here: films with pixels, filters, samplers, scene files, geometry. This crate
+//! knows nothing of BVHs, images or files; it depends on `obscura-space`, `obscura-sample`
+//! (for the aperture warps) and glam.
+//!
+//! The design decision: **the pose is separate from the projection**. The projection chain is
+//! built once (in f64, with closed-form inverses, so `far = 1e30` is safe); the pose is an
+//! [`AnimatedTransform`](obscura_space::AnimatedTransform) evaluated at each ray's own time,
+//! which is all camera motion blur needs. Conventions (axes, windows, pixel centres, the
+//! environment mapping, the time mapping) are those of the scene format: camera +z is the view,
+//! +y up, +x the image's right, which makes the camera frame left-handed in a right-handed
+//! world.
+//!
+//! ```
+//! use obscura_camera::{
+//!     Camera, CameraBase, CameraSample, FilmGeometry, FovAxis, PerspectiveCamera, Shutter,
+//!     ThinLens, look_at_pose,
+//! };
+//! use obscura_space::{Point2, Point3, Vector3};
+//!
+//! // A 2 x 2 image, fov 90 degrees, eye at the origin looking down world -z.
+//! let shutter = Shutter::new(0.0, 1.0)?;
+//! let eye = (Point3::new(0.0, 0.0, 0.0), Point3::new(0.0, 0.0, -1.0), Vector3::new(0.0, 1.0, 0.0));
+//! let base = CameraBase::new(look_at_pose(eye, None, shutter)?, shutter, FilmGeometry::new([2, 2], None, None)?);
+//! let camera = PerspectiveCamera::new(base, 90.0, FovAxis::Smaller, ThinLens::PINHOLE)?;
+//!
+//! // Pixel (0, 0), centre (0.5, 0.5): NDC (0.25, 0.25), screen (-0.5, 0.5), camera direction
+//! // normalize(-0.5, 0.5, 1), which in the world is up and to the left of -z.
+//! let ray = camera.generate_ray(&CameraSample::at(Point2::new(0.5, 0.5))).unwrap().ray;
+//! let expected = glam::Vec3::new(-0.5, 0.5, -1.0).normalize();
+//! assert!((ray.direction.to_glam() - expected).length() < 1e-6);
+//! // And back: the point 3 units along the ray projects to the same raster position.
+//! let p_raster = camera.project(ray.at(3.0), 0.0).unwrap();
+//! assert!((p_raster.x - 0.5).abs() < 1e-4 && (p_raster.y - 0.5).abs() < 1e-4);
+//! # Ok::<(), obscura_camera::CameraError>(())
+//! ```
+#![deny(missing_docs)]
+
+mod any;
+mod camera;
+mod environment;
+mod error;
+mod film;
+mod orthographic;
+mod perspective;
+mod projective;
+
+pub use any::AnyCamera;
+pub use camera::{
+    Camera, CameraBase, CameraRay, CameraRayDifferential, CameraSample, DEFAULT_FAR, DEFAULT_NEAR,
+    LookAt, ThinLens, look_at_pose,
+};
+pub use environment::EnvironmentCamera;
+pub use error::CameraError;
+pub use film::{FilmGeometry, FovAxis, MAX_RESOLUTION, ScreenWindow, Shutter};
+pub use orthographic::OrthographicCamera;
+pub use perspective::PerspectiveCamera;
+pub use projective::ProjectiveCamera;

@@ -1,0 +1,72 @@
+//! The closed set of camera models as one enum.
+
+use crate::camera::{Camera, CameraRay, CameraRayDifferential, CameraSample};
+use crate::environment::EnvironmentCamera;
+use crate::film::{FilmGeometry, Shutter};
+use crate::orthographic::OrthographicCamera;
+use crate::perspective::PerspectiveCamera;
+use obscura_space::{AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, World};
+
+/// Any of the camera models, dispatched by `match` (no trait objects on the per-ray path).
+#[derive(Debug, Clone)]
+pub enum AnyCamera {
+    /// A perspective camera.
+    Perspective(PerspectiveCamera),
+    /// An orthographic camera.
+    Orthographic(OrthographicCamera),
+    /// An environment camera.
+    Environment(EnvironmentCamera),
+}
+
+macro_rules! dispatch {
+    ($self:ident, $c:ident => $e:expr) => {
+        match $self {
+            AnyCamera::Perspective($c) => $e,
+            AnyCamera::Orthographic($c) => $e,
+            AnyCamera::Environment($c) => $e,
+        }
+    };
+}
+
+impl Camera for AnyCamera {
+    #[inline]
+    fn generate_ray(&self, sample: &CameraSample) -> Option<CameraRay> {
+        dispatch!(self, c => c.generate_ray(sample))
+    }
+    #[inline]
+    fn generate_ray_differential(&self, sample: &CameraSample) -> Option<CameraRayDifferential> {
+        dispatch!(self, c => c.generate_ray_differential(sample))
+    }
+    #[inline]
+    fn project(&self, p: Point3<World>, time: f32) -> Option<Point2<Raster>> {
+        dispatch!(self, c => c.project(p, time))
+    }
+    #[inline]
+    fn film(&self) -> &FilmGeometry {
+        dispatch!(self, c => c.film())
+    }
+    #[inline]
+    fn shutter(&self) -> Shutter {
+        dispatch!(self, c => c.shutter())
+    }
+    #[inline]
+    fn world_from_camera(&self) -> &AnimatedTransform<World, CameraSpace> {
+        dispatch!(self, c => c.world_from_camera())
+    }
+}
+
+impl From<PerspectiveCamera> for AnyCamera {
+    fn from(c: PerspectiveCamera) -> Self {
+        AnyCamera::Perspective(c)
+    }
+}
+impl From<OrthographicCamera> for AnyCamera {
+    fn from(c: OrthographicCamera) -> Self {
+        AnyCamera::Orthographic(c)
+    }
+}
+impl From<EnvironmentCamera> for AnyCamera {
+    fn from(c: EnvironmentCamera) -> Self {
+        AnyCamera::Environment(c)
+    }
+}

@@ -1,0 +1,410 @@
+//! The `Camera` trait, the samples it takes and the rays it gives, and what all models share:
+//! the pose, the shutter, the film and the clip range.
+
+use crate::error::{CameraError, finite};
+use crate::film::{FilmGeometry, Shutter, validate_near_far};
+use obscura_space::{
+    AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, Ray, Transform, Vector3,
+    World,
+};
+
+/// The default near clip distance of the scene format.
+pub const DEFAULT_NEAR: f32 = 0.001;
+/// The default far clip distance of the scene format (effectively none).
+pub const DEFAULT_FAR: f32 = 1.0e30;
+
+/// The canonical numbers one camera ray is made from, filled in by the sampler.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CameraSample {
+    /// The film position in raster space (pixel `(i, j)` covers `[i, i+1) x [j, j+1)`).
+    pub p_film: Point2<Raster>,
+    /// The lens sample in `[0, 1)^2`, warped onto the aperture by the camera.
+    pub p_lens: glam::Vec2,
+    /// The time sample `u` in `[0, 1)`, mapped onto the shutter interval by the camera.
+    pub time: f32,
+}
+
+impl CameraSample {
+    /// A sample at a film position through the lens centre at shutter open: what a pinhole
+    /// camera needs.
+    pub fn at(p_film: Point2<Raster>) -> Self {
+        CameraSample {
+            p_film,
+            p_lens: glam::Vec2::splat(0.5),
+            time: 0.0,
+        }
+    }
+}
+
+/// A world-space ray with a unit direction, its `[t_min, t_max]` the visible range, and the
+/// weight the radiance along it gets.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CameraRay {
+    /// The ray; `t` is a distance along it, since the direction is unit length.
+    pub ray: Ray<World>,
+    /// The ray's weight (1 for every model here).
+    pub weight: f32,
+}
+
+/// A camera ray with the rays of the film positions one pixel to the right (`rx`) and one
+/// pixel down (`ry`), with the same lens sample and time. Directions are unit length.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CameraRayDifferential {
+    /// The main ray, as [`Camera::generate_ray`] gives it.
+    pub ray: Ray<World>,
+    /// Origin of the ray one pixel to the right.
+    pub rx_origin: Point3<World>,
+    /// Direction of the ray one pixel to the right.
+    pub rx_direction: Vector3<World>,
+    /// Origin of the ray one pixel down.
+    pub ry_origin: Point3<World>,
+    /// Direction of the ray one pixel down.
+    pub ry_direction: Vector3<World>,
+    /// The main ray's weight.
+    pub weight: f32,
+}
+
+/// A camera model: rays from samples, and the inverse, world points to raster positions.
+pub trait Camera: Send + Sync {
+    /// The world-space ray of a sample, at time `shutter().time_at(sample.time)`, with a unit
+    /// direction and `[t_min, t_max]` set to the camera's clip range. `None` when the sample
+    /// gives no ray (a non-finite film position).
+    fn generate_ray(&self, sample: &CameraSample) -> Option<CameraRay>;
+
+    /// [`Camera::generate_ray`] plus the rays one pixel right and one pixel down, with the same
+    /// lens sample and time.
+    fn generate_ray_differential(&self, sample: &CameraSample) -> Option<CameraRayDifferential>;
+
+    /// Raster position of a world point at `time` (pinhole through the lens centre). None when
+    /// no ray of the camera can see it (behind a projective camera / outside [near, far] / at the
+    /// origin); positions outside the image rectangle ARE returned (renderers use them for
+    /// screen velocities).
+    fn project(&self, p: Point3<World>, time: f32) -> Option<Point2<Raster>>;
+
+    /// The film geometry: resolution, screen window, crop.
+    fn film(&self) -> &FilmGeometry;
+
+    /// The shutter interval.
+    fn shutter(&self) -> Shutter;
+
+    /// The camera's pose over the shutter interval.
+    fn world_from_camera(&self) -> &AnimatedTransform<World, CameraSpace>;
+}
+
+/// A thin lens: the aperture radius, the distance of the plane in focus, and the aperture's
+/// shape.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ThinLens {
+    /// Aperture radius in camera-space units; 0 is a pinhole.
+    pub radius: f32,
+    /// Camera-space z of the plane in perfect focus; > 0.
+    pub focal_distance: f32,
+    /// Aperture blades: 0 for a round aperture, else at least 3 (a regular polygon).
+    pub blades: u32,
+    /// Rotation of the polygonal aperture in degrees, counter-clockwise from camera +x.
+    pub rotation_degrees: f32,
+}
+
+impl ThinLens {
+    /// The pinhole: radius 0 (the focal distance then does not matter).
+    pub const PINHOLE: ThinLens = ThinLens {
+        radius: 0.0,
+        focal_distance: 1.0,
+        blades: 0,
+        rotation_degrees: 0.0,
+    };
+
+    /// A round thin lens. Errors as [`ThinLens::validate`].
+    pub fn new(radius: f32, focal_distance: f32) -> Result<ThinLens, CameraError> {
+        let lens = ThinLens {
+            radius,
+            focal_distance,
+            ..ThinLens::PINHOLE
+        };
+        lens.validate()?;
+        Ok(lens)
+    }
+
+    /// The same lens with a polygonal aperture of `blades` blades rotated by `rotation_degrees`
+    /// (0 blades for round). Errors as [`ThinLens::validate`].
+    pub fn with_blades(self, blades: u32, rotation_degrees: f32) -> Result<ThinLens, CameraError> {
+        let lens = ThinLens {
+            blades,
+            rotation_degrees,
+            ..self
+        };
+        lens.validate()?;
+        Ok(lens)
+    }
+
+    /// Checks the parameters: finite numbers, `radius >= 0`, `focal_distance > 0`, `blades` 0
+    /// or at least 3.
+    pub fn validate(&self) -> Result<(), CameraError> {
+        finite("lens_radius", self.radius)?;
+        finite("focal_distance", self.focal_distance)?;
+        finite("aperture rotation", self.rotation_degrees)?;
+        if self.radius < 0.0 {
+            return Err(CameraError::LensRadius { got: self.radius });
+        }
+        if self.focal_distance <= 0.0 {
+            return Err(CameraError::FocalDistance {
+                got: self.focal_distance,
+            });
+        }
+        if self.blades == 1 || self.blades == 2 {
+            return Err(CameraError::Blades { got: self.blades });
+        }
+        Ok(())
+    }
+
+    /// True when the lens has an aperture (radius > 0).
+    #[inline]
+    pub fn is_thin_lens(&self) -> bool {
+        self.radius > 0.0
+    }
+
+    /// The point of the aperture (camera space, on the plane z = 0) of a lens sample in
+    /// `[0, 1)^2`: the concentric disk, or the regular polygon, scaled by the radius.
+    #[inline]
+    pub fn aperture_point(&self, u: glam::Vec2) -> glam::Vec2 {
+        let unit = if self.blades >= 3 {
+            obscura_sample::square_to_polygon(u, self.blades, self.rotation_degrees)
+        } else {
+            obscura_sample::square_to_concentric_disk(u)
+        };
+        self.radius * unit
+    }
+}
+
+impl Default for ThinLens {
+    fn default() -> Self {
+        ThinLens::PINHOLE
+    }
+}
+
+/// What every camera model has: its pose over the shutter, the shutter, the film and the clip
+/// range (camera-space z for projective cameras, distance for the environment camera).
+#[derive(Debug, Clone)]
+pub struct CameraBase {
+    /// The pose: camera space to world space, evaluated at each ray's time.
+    pub world_from_camera: AnimatedTransform<World, CameraSpace>,
+    /// The shutter interval.
+    pub shutter: Shutter,
+    /// The film geometry.
+    pub film: FilmGeometry,
+    /// Near clip (>= 0; > 0 for perspective).
+    pub near: f32,
+    /// Far clip (> near, finite; [`DEFAULT_FAR`] for "none").
+    pub far: f32,
+}
+
+impl CameraBase {
+    /// A base with the default clip range [`DEFAULT_NEAR`], [`DEFAULT_FAR`].
+    pub fn new(
+        world_from_camera: AnimatedTransform<World, CameraSpace>,
+        shutter: Shutter,
+        film: FilmGeometry,
+    ) -> CameraBase {
+        CameraBase {
+            world_from_camera,
+            shutter,
+            film,
+            near: DEFAULT_NEAR,
+            far: DEFAULT_FAR,
+        }
+    }
+
+    /// The same base with the clip range `[near, far]` (checked by the camera constructors).
+    pub fn with_clip(self, near: f32, far: f32) -> CameraBase {
+        CameraBase { near, far, ..self }
+    }
+
+    /// Checks the shutter and the clip range; `positive_near` refuses `near == 0`.
+    pub(crate) fn validate(&self, positive_near: bool) -> Result<(), CameraError> {
+        Shutter::new(self.shutter.open, self.shutter.close)?;
+        validate_near_far(self.near, self.far, positive_near)
+    }
+
+    /// The pose at `time`; the hot path skips the interpolation for a fixed camera.
+    #[inline]
+    pub(crate) fn pose(&self, time: f32) -> Transform<World, CameraSpace> {
+        self.world_from_camera.at(time)
+    }
+}
+
+/// A look-at: eye, target and up, in world space.
+pub type LookAt = (Point3<World>, Point3<World>, Vector3<World>);
+
+/// Camera pose from look-at at shutter open and, optionally, at shutter close (the scene
+/// format's `eye_end`, `target_end`, `up_end`). The result is fixed when `end` is None or the
+/// shutter is instantaneous (`open == close`; the start pose is then used).
+///
+/// The camera frame is left-handed in the right-handed world (determinant -1); both keyframes
+/// share that, so they interpolate rigidly. Errors: a degenerate look-at (eye == target, up
+/// parallel to the view, non-finite numbers).
+pub fn look_at_pose(
+    start: LookAt,
+    end: Option<LookAt>,
+    shutter: Shutter,
+) -> Result<AnimatedTransform<World, CameraSpace>, CameraError> {
+    let start_pose = Transform::look_at(start.0, start.1, start.2)?;
+    match end {
+        Some(end) if shutter.open < shutter.close => {
+            let end_pose = Transform::look_at(end.0, end.1, end.2)?;
+            Ok(AnimatedTransform::new(
+                start_pose,
+                shutter.open,
+                end_pose,
+                shutter.close,
+            )?)
+        }
+        _ => Ok(AnimatedTransform::fixed(start_pose)),
+    }
+}
+
+/// Moves a camera-space ray to world space with `pose`, keeping the direction unit length:
+/// a pose with scale would stretch it, so the direction is renormalised and the `t` range
+/// rescaled to keep the same points.
+#[inline]
+pub(crate) fn to_world(pose: &Transform<World, CameraSpace>, ray: Ray<CameraSpace>) -> Ray<World> {
+    let ray = pose.ray(ray);
+    let length = ray.direction.length();
+    Ray {
+        direction: ray.direction / length,
+        t_min: ray.t_min * length,
+        t_max: ray.t_max * length,
+        ..ray
+    }
+}
+
+/// Assembles a differential from three world rays.
+#[inline]
+pub(crate) fn differential(
+    ray: Ray<World>,
+    rx: Ray<World>,
+    ry: Ray<World>,
+) -> CameraRayDifferential {
+    CameraRayDifferential {
+        ray,
+        rx_origin: rx.origin,
+        rx_direction: rx.direction,
+        ry_origin: ry.origin,
+        ry_direction: ry.direction,
+        weight: 1.0,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lens_validation() {
+        assert!(ThinLens::new(0.0, 1.0).is_ok());
+        assert!(matches!(
+            ThinLens::new(-0.1, 1.0),
+            Err(CameraError::LensRadius { .. })
+        ));
+        assert!(matches!(
+            ThinLens::new(0.1, 0.0),
+            Err(CameraError::FocalDistance { .. })
+        ));
+        assert!(matches!(
+            ThinLens::new(f32::NAN, 1.0),
+            Err(CameraError::NonFinite { .. })
+        ));
+        let lens = ThinLens::new(0.1, 2.0).unwrap();
+        assert!(lens.with_blades(2, 0.0).is_err());
+        assert!(lens.with_blades(6, 15.0).is_ok());
+    }
+
+    #[test]
+    fn aperture_points_stay_inside_the_radius() {
+        let lens = ThinLens::new(0.5, 1.0).unwrap();
+        let hex = lens.with_blades(6, 0.0).unwrap();
+        for i in 0..16 {
+            for j in 0..16 {
+                let u = glam::Vec2::new(i as f32 / 16.0, j as f32 / 16.0);
+                assert!(lens.aperture_point(u).length() <= 0.5 + 1e-6);
+                assert!(hex.aperture_point(u).length() <= 0.5 + 1e-6);
+            }
+        }
+        // The centre of the square is the centre of the lens.
+        assert_eq!(lens.aperture_point(glam::Vec2::splat(0.5)), glam::Vec2::ZERO);
+    }
+
+    #[test]
+    fn look_at_pose_is_fixed_without_end_or_with_instant_shutter() {
+        let start = (
+            Point3::new(0.0, 0.0, 0.0),
+            Point3::new(0.0, 0.0, -1.0),
+            Vector3::new(0.0, 1.0, 0.0),
+        );
+        let end = (
+            Point3::new(1.0, 0.0, 0.0),
+            Point3::new(1.0, 0.0, -1.0),
+            Vector3::new(0.0, 1.0, 0.0),
+        );
+        let shutter = Shutter::new(0.0, 1.0).unwrap();
+        assert!(!look_at_pose(start, None, shutter).unwrap().is_animated());
+        assert!(look_at_pose(start, Some(end), shutter).unwrap().is_animated());
+        let instant = Shutter::new(0.5, 0.5).unwrap();
+        assert!(!look_at_pose(start, Some(end), instant).unwrap().is_animated());
+        let bad = (start.0, start.0, start.2);
+        assert!(matches!(
+            look_at_pose(bad, None, shutter),
+            Err(CameraError::Pose(_))
+        ));
+    }
+}
+
+/// The camera-space ray of one film point, lens sample and time; the model's own part.
+pub(crate) trait CameraRayModel {
+    fn base(&self) -> &CameraBase;
+    fn ray_camera(&self, p_film: Point2<Raster>, u_lens: glam::Vec2) -> Ray<CameraSpace>;
+}
+
+/// True when every number of the sample is finite.
+#[inline]
+fn sample_is_finite(sample: &CameraSample) -> bool {
+    sample.p_film.is_finite() && sample.p_lens.is_finite() && sample.time.is_finite()
+}
+
+/// [`Camera::generate_ray`] for any model: camera-space ray, time, pose, world space.
+#[inline]
+pub(crate) fn generate<M: CameraRayModel>(model: &M, sample: &CameraSample) -> Option<CameraRay> {
+    if !sample_is_finite(sample) {
+        return None;
+    }
+    let base = model.base();
+    let time = base.shutter.time_at(sample.time);
+    let mut ray_camera = model.ray_camera(sample.p_film, sample.p_lens);
+    ray_camera.time = time;
+    let pose = base.pose(time);
+    Some(CameraRay {
+        ray: to_world(&pose, ray_camera),
+        weight: 1.0,
+    })
+}
+
+/// [`Camera::generate_ray_differential`] for any model: the three rays share the lens sample,
+/// the time and the pose (evaluated once).
+#[inline]
+pub(crate) fn generate_differential<M: CameraRayModel>(
+    model: &M,
+    sample: &CameraSample,
+) -> Option<CameraRayDifferential> {
+    if !sample_is_finite(sample) {
+        return None;
+    }
+    let base = model.base();
+    let time = base.shutter.time_at(sample.time);
+    let pose = base.pose(time);
+    let world = |dx: f32, dy: f32| {
+        let p_film = Point2::new(sample.p_film.x + dx, sample.p_film.y + dy);
+        let mut ray_camera = model.ray_camera(p_film, sample.p_lens);
+        ray_camera.time = time;
+        to_world(&pose, ray_camera)
+    };
+    Some(differential(world(0.0, 0.0), world(1.0, 0.0), world(0.0, 1.0)))
+}

@@ -1,0 +1,149 @@
+//! The perspective camera, pinhole or thin lens.
+
+use crate::camera::{
+    Camera, CameraBase, CameraRay, CameraRayDifferential, CameraRayModel, CameraSample, ThinLens,
+    generate, generate_differential,
+};
+use crate::error::{CameraError, finite};
+use crate::film::{FilmGeometry, FovAxis, Shutter};
+use crate::projective::{ProjectiveCamera, from_rows};
+use obscura_space::{
+    AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, Ray, World,
+};
+
+/// A perspective camera: the projection plane at camera z = 1 scaled so that the field of view
+/// spans the screen window's half-extent along [`FovAxis`]; rays from the eye (or, with a thin
+/// lens, from a point of the aperture) through the film point, clipped to camera z in
+/// `[near, far]`.
+///
+/// `screen_from_camera` is pbrt's perspective matrix with the scale `s = h / tan(fov / 2)`
+/// (`h` the half-extent the fov spans):
+///
+/// ```text
+/// [ s  0  0            0            ]          screen x = s x / z,  screen y = s y / z,
+/// [ 0  s  0            0            ]          screen z = f (z - n) / ((f - n) z):
+/// [ 0  0  f / (f - n)  -f n / (f - n)]          0 at z = n, 1 at z = f.
+/// [ 0  0  1            0            ]
+/// ```
+///
+/// Its inverse is written in closed form (last two rows `[0 0 0 1]` and
+/// `[0 0 1/f - 1/n  1/n]`), so `far = 1e30` costs no precision.
+#[derive(Debug, Clone)]
+pub struct PerspectiveCamera {
+    projective: ProjectiveCamera,
+    fov_degrees: f32,
+    fov_axis: FovAxis,
+}
+
+impl PerspectiveCamera {
+    /// A perspective camera with a full field of view of `fov_degrees` along `fov_axis`.
+    ///
+    /// Errors: fov not in (0, 180), non-finite numbers, `near <= 0`, `near >= far`, a bad
+    /// shutter or lens (see [`ThinLens::validate`]).
+    pub fn new(
+        base: CameraBase,
+        fov_degrees: f32,
+        fov_axis: FovAxis,
+        lens: ThinLens,
+    ) -> Result<PerspectiveCamera, CameraError> {
+        finite("fov", fov_degrees)?;
+        if !(fov_degrees > 0.0 && fov_degrees < 180.0) {
+            return Err(CameraError::Fov { got: fov_degrees });
+        }
+        base.validate(true)?;
+        // The fov spans the chosen half-extent h of the window: s = h / tan(fov / 2).
+        let half_extent = f64::from(fov_axis.half_extent(base.film.screen_window()));
+        let scale = half_extent / (0.5 * f64::from(fov_degrees)).to_radians().tan();
+        if !(scale as f32).is_finite() || scale as f32 <= 0.0 {
+            return Err(CameraError::Fov { got: fov_degrees });
+        }
+        let (n, f) = (f64::from(base.near), f64::from(base.far));
+        let screen_from_camera = from_rows([
+            [scale, 0.0, 0.0, 0.0],
+            [0.0, scale, 0.0, 0.0],
+            [0.0, 0.0, f / (f - n), -f * n / (f - n)],
+            [0.0, 0.0, 1.0, 0.0],
+        ]);
+        let camera_from_screen = from_rows([
+            [1.0 / scale, 0.0, 0.0, 0.0],
+            [0.0, 1.0 / scale, 0.0, 0.0],
+            [0.0, 0.0, 0.0, 1.0],
+            [0.0, 0.0, 1.0 / f - 1.0 / n, 1.0 / n],
+        ]);
+        let projective =
+            ProjectiveCamera::build(base, lens, (screen_from_camera, camera_from_screen), true)?;
+        Ok(PerspectiveCamera {
+            projective,
+            fov_degrees,
+            fov_axis,
+        })
+    }
+
+    /// The projective chain (screen, NDC and raster transforms).
+    #[inline]
+    pub fn projective(&self) -> &ProjectiveCamera {
+        &self.projective
+    }
+    /// The full field of view in degrees.
+    #[inline]
+    pub fn fov_degrees(&self) -> f32 {
+        self.fov_degrees
+    }
+    /// The axis the field of view is measured along.
+    #[inline]
+    pub fn fov_axis(&self) -> FovAxis {
+        self.fov_axis
+    }
+    /// The lens.
+    #[inline]
+    pub fn lens(&self) -> ThinLens {
+        self.projective.lens()
+    }
+}
+
+impl CameraRayModel for PerspectiveCamera {
+    #[inline]
+    fn base(&self) -> &CameraBase {
+        self.projective.base()
+    }
+
+    #[inline]
+    fn ray_camera(&self, p_film: Point2<Raster>, u_lens: glam::Vec2) -> Ray<CameraSpace> {
+        // The film point on the near plane gives the pinhole direction from the eye.
+        let p_camera = self.projective.film_point(p_film);
+        let d_camera = p_camera.to_vector().normalize();
+        if self.projective.lens().is_thin_lens() {
+            self.projective
+                .through_lens(Point3::ORIGIN, d_camera, u_lens)
+        } else {
+            self.projective.clipped(Point3::ORIGIN, d_camera)
+        }
+    }
+}
+
+impl Camera for PerspectiveCamera {
+    #[inline]
+    fn generate_ray(&self, sample: &CameraSample) -> Option<CameraRay> {
+        generate(self, sample)
+    }
+    #[inline]
+    fn generate_ray_differential(&self, sample: &CameraSample) -> Option<CameraRayDifferential> {
+        generate_differential(self, sample)
+    }
+    fn project(&self, p: Point3<World>, time: f32) -> Option<Point2<Raster>> {
+        let camera_from_world = self.base().pose(time).inverse();
+        self.projective.project_camera(camera_from_world.point(p))
+    }
+    #[inline]
+    fn film(&self) -> &FilmGeometry {
+        &self.base().film
+    }
+    #[inline]
+    fn shutter(&self) -> Shutter {
+        self.base().shutter
+    }
+    #[inline]
+    fn world_from_camera(&self) -> &AnimatedTransform<World, CameraSpace> {
+        &self.base().world_from_camera
+    }
+}
