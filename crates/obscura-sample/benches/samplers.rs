@@ -1,6 +1,11 @@
 //! Dimension values per second per sampler: one camera sample (5 dimensions) plus three
 //! shading pairs, for every sample of a small tile, through the stream as a renderer would.
 
+#![allow(
+    missing_docs,
+    reason = "criterion_group! generates an undocumented public function"
+)]
+
 use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};

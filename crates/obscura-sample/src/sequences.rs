@@ -42,7 +42,7 @@ pub(crate) fn independent(pixel_key: u64, seed: u64, index: u32, dimension: u32)
 /// `1 x spp`).
 pub(crate) fn stratified_grid(spp: u32) -> [u32; 2] {
     let mut nx = spp.isqrt().max(1);
-    while spp % nx != 0 {
+    while !spp.is_multiple_of(nx) {
         nx -= 1;
     }
     [nx, spp / nx]
@@ -79,7 +79,7 @@ pub(crate) fn stratified(
     let i = s % nx;
     let j = s / nx;
     // Fine stratum within the column (x) or row (y), and a jitter inside it.
-    let (fine, component_key) = if dimension % 2 == 0 {
+    let (fine, component_key) = if dimension.is_multiple_of(2) {
         let key = combine(pattern_key, 2 * u64::from(i));
         (i * ny + permute(j, ny, key), key)
     } else {
@@ -108,7 +108,7 @@ const fn first_primes() -> [u32; NUM_PRIMES] {
         let mut is_prime = true;
         let mut k = 0;
         while k < count && primes[k] * primes[k] <= candidate {
-            if candidate % primes[k] == 0 {
+            if candidate.is_multiple_of(primes[k]) {
                 is_prime = false;
                 break;
             }
@@ -192,7 +192,7 @@ pub(crate) fn sobol(pixel_key: u64, index: u32, dimension: u32) -> f32 {
     let pair = dimension / 2;
     let pair_key = combine(combine(pixel_key, TAG_SOBOL), u64::from(pair));
     let shuffled = owen_scramble(index, pair_key as u32);
-    let raw = if dimension % 2 == 0 {
+    let raw = if dimension.is_multiple_of(2) {
         shuffled.reverse_bits()
     } else {
         sobol_second(shuffled)
