@@ -1,0 +1,230 @@
+//! Piecewise-constant distributions in one and two dimensions, for importance sampling
+//! environment maps and choosing triangles by area.
+
+use glam::Vec2;
+use obscura_sample::ONE_MINUS_EPSILON;
+
+/// A piecewise-constant density over `[0, 1)` with `n` equal bins of non-negative weights.
+/// When every weight is zero it falls back to the uniform density (so sampling never fails).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Distribution1D {
+    func: Vec<f32>,
+    cdf: Vec<f32>,
+    integral: f32,
+}
+
+impl Distribution1D {
+    /// A distribution over the given bin weights (non-negative and finite; others count as 0).
+    /// An empty slice is treated as one bin.
+    pub fn new(weights: &[f32]) -> Distribution1D {
+        let mut func: Vec<f32> = weights
+            .iter()
+            .map(|&w| if w.is_finite() && w > 0.0 { w } else { 0.0 })
+            .collect();
+        if func.is_empty() {
+            func.push(1.0);
+        }
+        let n = func.len();
+        // Running sums in f64 so long rows do not lose their small bins.
+        let mut cdf = Vec::with_capacity(n + 1);
+        let mut sum = 0.0f64;
+        cdf.push(0.0f32);
+        for &f in &func {
+            sum += f64::from(f) / n as f64;
+            cdf.push(sum as f32);
+        }
+        let integral = sum as f32;
+        if integral > 0.0 {
+            for c in cdf.iter_mut().skip(1) {
+                *c /= integral;
+            }
+        } else {
+            for (i, c) in cdf.iter_mut().enumerate() {
+                *c = i as f32 / n as f32;
+            }
+        }
+        cdf[n] = 1.0;
+        Distribution1D {
+            func,
+            cdf,
+            integral,
+        }
+    }
+
+    /// The number of bins.
+    pub fn len(&self) -> usize {
+        self.func.len()
+    }
+
+    /// Always false: there is at least one bin.
+    pub fn is_empty(&self) -> bool {
+        false
+    }
+
+    /// The integral of the weights over `[0, 1)` (their mean); 0 if they are all zero.
+    pub fn integral(&self) -> f32 {
+        self.integral
+    }
+
+    /// The bin holding `x` in `[0, 1)` (clamped).
+    fn bin(&self, x: f32) -> usize {
+        ((x * self.len() as f32) as usize).min(self.len() - 1)
+    }
+
+    /// The density at `x` in `[0, 1)` with respect to `x`.
+    pub fn pdf(&self, x: f32) -> f32 {
+        if self.integral > 0.0 {
+            self.func[self.bin(x)] / self.integral
+        } else {
+            1.0
+        }
+    }
+
+    /// The probability of bin `i` (its share of the total weight).
+    pub fn discrete_pdf(&self, i: usize) -> f32 {
+        match self.func.get(i) {
+            Some(&f) if self.integral > 0.0 => f / (self.integral * self.len() as f32),
+            Some(_) => 1.0 / self.len() as f32,
+            None => 0.0,
+        }
+    }
+
+    /// Inverts the CDF: returns `(x, pdf(x), bin)` for a canonical `u` in `[0, 1)`.
+    pub fn sample_continuous(&self, u: f32) -> (f32, f32, usize) {
+        let i = self.find(u);
+        let (c0, c1) = (self.cdf[i], self.cdf[i + 1]);
+        let du = if c1 > c0 { (u - c0) / (c1 - c0) } else { 0.5 };
+        let x = ((i as f32 + du.clamp(0.0, 1.0)) / self.len() as f32).min(ONE_MINUS_EPSILON);
+        (x, self.pdf(x), i)
+    }
+
+    /// Picks a bin with probability [`Distribution1D::discrete_pdf`]; returns it, its
+    /// probability and `u` re-stretched to `[0, 1)` within the bin (reusable as a fresh number).
+    pub fn sample_discrete(&self, u: f32) -> (usize, f32, f32) {
+        let i = self.find(u);
+        let (c0, c1) = (self.cdf[i], self.cdf[i + 1]);
+        let u_remapped = if c1 > c0 {
+            ((u - c0) / (c1 - c0)).clamp(0.0, ONE_MINUS_EPSILON)
+        } else {
+            0.5
+        };
+        (i, self.discrete_pdf(i), u_remapped)
+    }
+
+    /// The last bin `i` with `cdf[i] <= u`, skipping empty bins.
+    fn find(&self, u: f32) -> usize {
+        let n = self.len();
+        // partition_point: first index with cdf > u; the bin is one before it.
+        let first_above = self.cdf.partition_point(|&c| c <= u);
+        let mut i = first_above.saturating_sub(1).min(n - 1);
+        // Never land in a zero-weight bin through rounding at the CDF's flat parts.
+        while i + 1 < n && self.cdf[i + 1] <= self.cdf[i] {
+            i += 1;
+        }
+        i
+    }
+}
+
+/// A piecewise-constant density over `[0, 1)^2` on a `width x height` grid: a marginal
+/// distribution over rows (`v`) and a conditional one over columns (`u`) in each row.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Distribution2D {
+    conditional: Vec<Distribution1D>,
+    marginal: Distribution1D,
+}
+
+impl Distribution2D {
+    /// From row-major weights (`weights[y * width + x]`); `weights.len()` must be `width * height`.
+    pub fn new(weights: &[f32], width: usize, height: usize) -> Distribution2D {
+        let width = width.max(1);
+        let conditional: Vec<Distribution1D> = (0..height.max(1))
+            .map(|y| {
+                let row = weights.get(y * width..(y + 1) * width).unwrap_or(&[]);
+                Distribution1D::new(row)
+            })
+            .collect();
+        let row_integrals: Vec<f32> = conditional.iter().map(|d| d.integral()).collect();
+        let marginal = Distribution1D::new(&row_integrals);
+        Distribution2D {
+            conditional,
+            marginal,
+        }
+    }
+
+    /// Samples `(u, v)` in `[0, 1)^2` and returns it with its density.
+    pub fn sample(&self, u2: Vec2) -> (Vec2, f32) {
+        let (v, pdf_v, row) = self.marginal.sample_continuous(u2.y);
+        let (u, pdf_u, _) = self.conditional[row].sample_continuous(u2.x);
+        (Vec2::new(u, v), pdf_u * pdf_v)
+    }
+
+    /// The density at `(u, v)` in `[0, 1)^2`.
+    pub fn pdf(&self, p: Vec2) -> f32 {
+        let row = ((p.y * self.conditional.len() as f32) as usize).min(self.conditional.len() - 1);
+        self.marginal.pdf(p.y) * self.conditional[row].pdf(p.x)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    #[test]
+    fn hand_computed_1d() {
+        // Weights 1, 3, 0, 4 over four bins of width 1/4: integral = 8 / 4 = 2, so the pdf in
+        // bin 1 is 3 / 2 and the CDF is 0, 1/8, 4/8, 4/8, 1.
+        let d = Distribution1D::new(&[1.0, 3.0, 0.0, 4.0]);
+        assert_eq!(d.integral(), 2.0);
+        assert_eq!(d.pdf(0.3), 1.5);
+        assert_eq!(d.discrete_pdf(3), 0.5);
+        // u = 0.25 is a third of the way through bin 1's CDF span [1/8, 4/8): x = (1 + 1/3) / 4.
+        let (x, pdf, i) = d.sample_continuous(0.25);
+        assert_eq!(i, 1);
+        assert!((x - (1.0 + 1.0 / 3.0) / 4.0).abs() < 1e-6);
+        assert_eq!(pdf, 1.5);
+        // u = 0.5 sits on the flat part of the CDF at bin 2: it must go to bin 3, never bin 2.
+        assert_eq!(d.sample_continuous(0.5).2, 3);
+    }
+
+    #[test]
+    fn all_zero_falls_back_to_uniform() {
+        let d = Distribution1D::new(&[0.0, 0.0]);
+        assert_eq!(d.pdf(0.7), 1.0);
+        assert_eq!(d.discrete_pdf(1), 0.5);
+        let (x, _, _) = d.sample_continuous(0.75);
+        assert!((x - 0.75).abs() < 1e-6);
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(300))]
+        #[test]
+        fn sampled_pdf_matches_evaluated_pdf(
+            weights in proptest::collection::vec(0.0f32..10.0, 1..6),
+            ux in 0.0f32..1.0, uy in 0.0f32..1.0,
+        ) {
+            let w = 2;
+            let h = weights.len().div_ceil(w);
+            let mut padded = weights.clone();
+            padded.resize(w * h, 0.5);
+            let d = Distribution2D::new(&padded, w, h);
+            let (p, pdf) = d.sample(Vec2::new(ux, uy));
+            prop_assert!(p.x >= 0.0 && p.x < 1.0 && p.y >= 0.0 && p.y < 1.0);
+            prop_assert!(pdf > 0.0);
+            prop_assert!((d.pdf(p) - pdf).abs() <= 1e-4 * pdf.max(1.0));
+        }
+
+        #[test]
+        fn the_2d_pdf_integrates_to_one(weights in proptest::collection::vec(0.0f32..10.0, 6)) {
+            let d = Distribution2D::new(&weights, 3, 2);
+            // Midpoint rule over the grid's cells is exact for a piecewise-constant density.
+            let mut sum = 0.0;
+            for y in 0..2 {
+                for x in 0..3 {
+                    sum += d.pdf(Vec2::new((x as f32 + 0.5) / 3.0, (y as f32 + 0.5) / 2.0)) / 6.0;
+                }
+            }
+            prop_assert!((sum - 1.0).abs() < 1e-4);
+        }
+    }
+}
