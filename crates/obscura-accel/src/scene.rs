@@ -1,0 +1,812 @@
+//! Shapes, instances, the two-level BVH and the ray queries.
+
+use crate::error::AccelError;
+use crate::geom::{
+    QuadHit, TriangleHit, gamma, intersect_quad, intersect_sphere, intersect_triangle,
+    transform_point_with_error,
+};
+use crate::hit::Hit;
+use crate::mesh::TriangleMesh;
+use glam::{Vec2, Vec3, Vec3A};
+use obscura_space::{
+    AnimatedTransform, Bounds3, Normal3, Object, Point3, Ray, Transform, Vector3, World,
+};
+use obvhs::BvhBuildParams;
+use obvhs::aabb::Aabb;
+use obvhs::cwbvh::CwBvh;
+use obvhs::cwbvh::builder::{build_cwbvh, build_cwbvh_from_tris};
+use obvhs::ray::RayHit;
+use obvhs::triangle::Triangle;
+use std::collections::HashMap;
+use std::sync::Arc;
+use std::time::Duration;
+
+/// A shape in its own object space.
+#[derive(Debug, Clone)]
+pub enum Shape {
+    /// A triangle mesh, shared between instances.
+    Mesh(Arc<TriangleMesh>),
+    /// An analytic sphere (exact ray-sphere intersection, not a tessellation).
+    Sphere {
+        /// The centre, in object space.
+        center: Vec3,
+        /// The radius, > 0.
+        radius: f32,
+    },
+    /// The parallelogram `origin + s * edge_u + t * edge_v`, `s, t` in `[0, 1]`; its normal is
+    /// `normalize(cross(edge_u, edge_v))`.
+    Quad {
+        /// One corner, in object space.
+        origin: Vec3,
+        /// The first edge from `origin`.
+        edge_u: Vec3,
+        /// The second edge from `origin`.
+        edge_v: Vec3,
+    },
+}
+
+/// Where an instance sits in the world.
+#[derive(Debug, Clone)]
+pub enum Placement {
+    /// A fixed `world_from_object` transform.
+    Static(Transform<World, Object>),
+    /// A `world_from_object` transform that moves over the shutter interval; rays meet the
+    /// object where it is at the ray's own time.
+    Moving(AnimatedTransform<World, Object>),
+}
+
+/// How much effort to spend building the per-mesh BVHs: obvhs's presets.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum BuildQuality {
+    /// `BvhBuildParams::fast_build()`: PLOC with a short search radius, little reinsertion.
+    Fast,
+    /// `BvhBuildParams::medium_build()` (the default): documented by obvhs as about embree's
+    /// build time with faster traversal; a renderer traces far more rays than it builds.
+    #[default]
+    Medium,
+    /// `BvhBuildParams::slow_build()`: spatial pre-splits and more reinsertion, for very
+    /// large renders of static scenes.
+    Slow,
+}
+
+impl BuildQuality {
+    fn params(self) -> BvhBuildParams {
+        match self {
+            BuildQuality::Fast => BvhBuildParams::fast_build(),
+            BuildQuality::Medium => BvhBuildParams::medium_build(),
+            BuildQuality::Slow => BvhBuildParams::slow_build(),
+        }
+    }
+}
+
+/// Collects instances, then builds a [`Scene`].
+#[derive(Debug, Clone, Default)]
+pub struct SceneBuilder {
+    instances: Vec<(Shape, Placement)>,
+    quality: BuildQuality,
+}
+
+impl SceneBuilder {
+    /// An empty builder with [`BuildQuality::Medium`].
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Sets the build quality of the per-mesh BVHs.
+    pub fn with_quality(mut self, quality: BuildQuality) -> Self {
+        self.quality = quality;
+        self
+    }
+
+    /// Adds an instance. Returns the instance index (0, 1, 2... in call order):
+    /// [`Hit::instance`] reports it. Errors for invalid shape parameters (non-finite values, a
+    /// radius <= 0, a quad of zero area) or a non-finite placement.
+    pub fn add(&mut self, shape: Shape, placement: Placement) -> Result<u32, AccelError> {
+        match &shape {
+            Shape::Mesh(_) => {}
+            Shape::Sphere { center, radius } => {
+                if !center.is_finite() || !radius.is_finite() || *radius <= 0.0 {
+                    return Err(AccelError::Shape(format!(
+                        "sphere: the centre must be finite and the radius finite and > 0 (got centre {:?}, radius {radius})",
+                        center.to_array()
+                    )));
+                }
+            }
+            Shape::Quad {
+                origin,
+                edge_u,
+                edge_v,
+            } => {
+                let n = edge_u.cross(*edge_v);
+                if !origin.is_finite() || !edge_u.is_finite() || !edge_v.is_finite() {
+                    return Err(AccelError::Shape(
+                        "quad: origin and edges must be finite".to_string(),
+                    ));
+                }
+                if n.length_squared() == 0.0 || !n.length_squared().is_finite() {
+                    return Err(AccelError::Shape(format!(
+                        "quad: edges {:?} and {:?} are parallel or zero (the quad has no area)",
+                        edge_u.to_array(),
+                        edge_v.to_array()
+                    )));
+                }
+            }
+        }
+        let finite = |t: &Transform<World, Object>| {
+            t.matrix().is_finite() && t.inverse_matrix().is_finite()
+        };
+        let ok = match &placement {
+            Placement::Static(t) => finite(t),
+            Placement::Moving(a) => a.keyframes().all(|(time, t)| time.is_finite() && finite(&t)),
+        };
+        if !ok {
+            return Err(AccelError::Placement(
+                "a transform has a NaN or infinite entry".to_string(),
+            ));
+        }
+        let index = u32::try_from(self.instances.len())
+            .map_err(|_| AccelError::Placement("more than 2^32 instances".to_string()))?;
+        self.instances.push((shape, placement));
+        Ok(index)
+    }
+
+    /// Builds the BVHs: one over every static mesh triangle, flattened to world space; one per
+    /// distinct moving mesh, in object space; and a top-level one over the flattened triangles,
+    /// the spheres, the quads and the moving meshes (each bounded over all times).
+    pub fn build(self) -> Result<Scene, AccelError> {
+        let params = self.quality.params();
+        let instance_count = self.instances.len();
+        let mut items = Vec::new();
+        let mut item_bounds: Vec<Bounds3<World>> = Vec::new();
+        let mut meshes = Vec::with_capacity(instance_count);
+        let mut statics = Vec::with_capacity(instance_count);
+        let mut flat_tris: Vec<[Vec3A; 3]> = Vec::new();
+        let mut flat_ids: Vec<[u32; 2]> = Vec::new();
+        let mut blases: Vec<Blas> = Vec::new();
+        let mut blas_of_mesh: HashMap<*const TriangleMesh, usize> = HashMap::new();
+
+        for (instance, (shape, placement)) in self.instances.into_iter().enumerate() {
+            let instance = instance as u32;
+            // A "moving" transform that does not move is static.
+            let placement = match placement {
+                Placement::Moving(a) if !a.is_animated() => Placement::Static(a.at(0.0)),
+                p => p,
+            };
+            let xform = match &placement {
+                Placement::Static(t) => Xform::Static(*t),
+                Placement::Moving(a) => Xform::Moving(a.clone()),
+            };
+            statics.push(match &placement {
+                Placement::Static(t) => Some(*t),
+                Placement::Moving(_) => None,
+            });
+            meshes.push(match &shape {
+                Shape::Mesh(m) => Some(m.clone()),
+                _ => None,
+            });
+            match shape {
+                Shape::Mesh(mesh) => match placement {
+                    Placement::Static(world_from_object) => {
+                        // Flatten: carry the triangles to world space once.
+                        let m = world_from_object.matrix();
+                        for (i, _) in mesh.triangles().iter().enumerate() {
+                            let corners = mesh
+                                .corners(i)
+                                .map(|p| Vec3A::from(m.transform_point3(p)));
+                            flat_tris.push(corners);
+                            flat_ids.push([instance, i as u32]);
+                        }
+                    }
+                    Placement::Moving(world_from_object) => {
+                        let key = Arc::as_ptr(&mesh);
+                        let blas = *blas_of_mesh.entry(key).or_insert_with(|| {
+                            let tris = (0..mesh.triangle_count())
+                                .map(|i| mesh.corners(i).map(Vec3A::from))
+                                .collect::<Vec<_>>();
+                            blases.push(Blas::build(tris, params));
+                            blases.len() - 1
+                        });
+                        item_bounds.push(world_from_object.motion_bounds(mesh.bounds()));
+                        items.push(Item::MovingMesh {
+                            instance,
+                            blas,
+                            world_from_object,
+                        });
+                    }
+                },
+                Shape::Sphere { center, radius } => {
+                    let r = Vec3::splat(radius);
+                    let b = Bounds3::new(
+                        Point3::from_glam(center - r),
+                        Point3::from_glam(center + r),
+                    );
+                    item_bounds.push(xform.bounds(b));
+                    items.push(Item::Analytic {
+                        instance,
+                        shape: Analytic::Sphere { center, radius },
+                        xform,
+                    });
+                }
+                Shape::Quad {
+                    origin,
+                    edge_u,
+                    edge_v,
+                } => {
+                    let b = Bounds3::from_points(
+                        [origin, origin + edge_u, origin + edge_v, origin + edge_u + edge_v]
+                            .map(Point3::from_glam),
+                    );
+                    item_bounds.push(xform.bounds(b));
+                    items.push(Item::Analytic {
+                        instance,
+                        shape: Analytic::Quad {
+                            origin,
+                            edge_u,
+                            edge_v,
+                        },
+                        xform,
+                    });
+                }
+            }
+        }
+
+        let flat = if flat_tris.is_empty() {
+            None
+        } else {
+            let b = Bounds3::from_points(
+                flat_tris
+                    .iter()
+                    .flatten()
+                    .map(|&p| Point3::from_glam(Vec3::from(p))),
+            );
+            item_bounds.push(b);
+            items.push(Item::Flat);
+            let blas = Blas::build(flat_tris, params);
+            let ids = blas.prims.iter().map(|&i| flat_ids[i as usize]).collect();
+            Some((blas, ids))
+        };
+        if item_bounds.iter().any(|b| !b.min.is_finite() || !b.max.is_finite()) {
+            return Err(AccelError::Placement(
+                "an instance's world bounds overflow (a transform is too large)".to_string(),
+            ));
+        }
+        let bounds = item_bounds.iter().fold(Bounds3::EMPTY, |a, b| a.union(*b));
+
+        // The top level: skipped when there is a single item (one mesh, the common benchmark).
+        let tlas = if items.len() > 1 {
+            let aabbs = item_bounds
+                .iter()
+                .map(|b| {
+                    // Pad flat boxes (a quad in an axis plane) by a relative hair.
+                    let d = b.diagonal().to_glam().abs().max_element();
+                    let pad = Vec3A::splat(d * 1e-6 + f32::MIN_POSITIVE);
+                    Aabb::new(Vec3A::from(b.min.to_glam()) - pad, Vec3A::from(b.max.to_glam()) + pad)
+                })
+                .collect::<Vec<_>>();
+            let bvh = build_cwbvh(&aabbs, BvhBuildParams::fast_build(), &mut Duration::default());
+            let order = bvh.primitive_indices.clone();
+            Some((bvh, order))
+        } else {
+            None
+        };
+
+        Ok(Scene {
+            items,
+            tlas,
+            flat,
+            blases,
+            meshes,
+            statics,
+            bounds,
+        })
+    }
+}
+
+/// A built scene, ready for ray queries from any number of threads.
+#[derive(Debug)]
+pub struct Scene {
+    items: Vec<Item>,
+    /// The top-level BVH and its slot -> item map; `None` for zero or one item.
+    tlas: Option<(CwBvh, Vec<u32>)>,
+    /// All static mesh triangles in world space, with (instance, triangle) per BVH slot.
+    flat: Option<(Blas, Vec<[u32; 2]>)>,
+    blases: Vec<Blas>,
+    meshes: Vec<Option<Arc<TriangleMesh>>>,
+    statics: Vec<Option<Transform<World, Object>>>,
+    bounds: Bounds3<World>,
+}
+
+/// A per-mesh BVH with its triangles stored in BVH slot order.
+#[derive(Debug)]
+struct Blas {
+    bvh: CwBvh,
+    tris: Vec<[Vec3A; 3]>,
+    /// The input index of the triangle in each slot.
+    prims: Vec<u32>,
+}
+
+impl Blas {
+    fn build(tris: Vec<[Vec3A; 3]>, params: BvhBuildParams) -> Blas {
+        let input = tris
+            .iter()
+            .map(|&[v0, v1, v2]| Triangle { v0, v1, v2 })
+            .collect::<Vec<_>>();
+        let bvh = build_cwbvh_from_tris(&input, params, &mut Duration::default());
+        let prims = bvh.primitive_indices.clone();
+        let tris = prims.iter().map(|&i| tris[i as usize]).collect();
+        Blas { bvh, tris, prims }
+    }
+
+    /// The closest triangle hit in `[t_min, t_max]`: its slot and hit.
+    #[inline]
+    fn closest(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> Option<(usize, TriangleHit)> {
+        let ray = obvhs::ray::Ray::new(o, d, t_min, t_max);
+        let mut ray_hit = RayHit::none();
+        let mut best = None;
+        self.bvh.ray_traverse(ray, &mut ray_hit, |r, slot| {
+            match intersect_triangle(r.origin, r.direction, r.tmin, r.tmax, &self.tris[slot]) {
+                Some(h) => {
+                    best = Some((slot, h));
+                    h.t
+                }
+                None => f32::INFINITY,
+            }
+        });
+        best
+    }
+
+    /// True when any triangle is hit in `[t_min, t_max]`.
+    #[inline]
+    fn any(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> bool {
+        let ray = obvhs::ray::Ray::new(o, d, t_min, t_max);
+        let mut hit = false;
+        self.bvh.ray_traverse_miss(ray, |r, slot| {
+            match intersect_triangle(r.origin, r.direction, r.tmin, r.tmax, &self.tris[slot]) {
+                Some(_) => {
+                    hit = true;
+                    // Below any tmax: stops the traversal.
+                    f32::NEG_INFINITY
+                }
+                None => f32::INFINITY,
+            }
+        });
+        hit
+    }
+}
+
+#[derive(Debug, Clone)]
+enum Xform {
+    Static(Transform<World, Object>),
+    Moving(AnimatedTransform<World, Object>),
+}
+
+impl Xform {
+    #[inline]
+    fn at(&self, time: f32) -> Transform<World, Object> {
+        match self {
+            Xform::Static(t) => *t,
+            Xform::Moving(a) => a.at(time),
+        }
+    }
+    fn bounds(&self, b: Bounds3<Object>) -> Bounds3<World> {
+        match self {
+            Xform::Static(t) => t.bounds(b),
+            Xform::Moving(a) => a.motion_bounds(b),
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy)]
+enum Analytic {
+    Sphere {
+        center: Vec3,
+        radius: f32,
+    },
+    Quad {
+        origin: Vec3,
+        edge_u: Vec3,
+        edge_v: Vec3,
+    },
+}
+
+#[derive(Debug)]
+enum Item {
+    /// The flattened static triangles.
+    Flat,
+    Analytic {
+        instance: u32,
+        shape: Analytic,
+        xform: Xform,
+    },
+    MovingMesh {
+        instance: u32,
+        blas: usize,
+        world_from_object: AnimatedTransform<World, Object>,
+    },
+}
+
+/// What a traversal found, enough to build the [`Hit`] afterwards.
+#[derive(Clone, Copy, Debug)]
+enum Found {
+    Flat { slot: usize, tri: TriangleHit },
+    Moving { item: usize, slot: usize, tri: TriangleHit },
+    Sphere { item: usize, t: f32 },
+    Quad { item: usize, quad: QuadHit },
+}
+
+impl Found {
+    fn t(&self) -> f32 {
+        match self {
+            Found::Flat { tri, .. } | Found::Moving { tri, .. } => tri.t,
+            Found::Sphere { t, .. } => *t,
+            Found::Quad { quad, .. } => quad.t,
+        }
+    }
+}
+
+/// A world ray as plain glam values, checked once.
+#[derive(Clone, Copy)]
+struct PlainRay {
+    o: Vec3A,
+    d: Vec3A,
+    time: f32,
+    t_min: f32,
+    t_max: f32,
+}
+
+impl PlainRay {
+    /// `None` for a ray that can hit nothing: non-finite or zero direction, NaN or empty range.
+    fn new(ray: &Ray<World>) -> Option<Self> {
+        let o = Vec3A::from(ray.origin.to_glam());
+        let d = Vec3A::from(ray.direction.to_glam());
+        let ok = o.is_finite()
+            && d.is_finite()
+            && d != Vec3A::ZERO
+            && !ray.t_min.is_nan()
+            && !ray.t_max.is_nan()
+            && ray.t_min <= ray.t_max;
+        ok.then_some(PlainRay {
+            o,
+            d,
+            time: ray.time,
+            t_min: ray.t_min,
+            t_max: ray.t_max,
+        })
+    }
+}
+
+impl Scene {
+    /// The closest hit with `t` in `[t_min, t_max]`, moving instances placed at the ray's time.
+    /// `None` for a miss, and for rays that cannot hit anything (non-finite origin or
+    /// direction, zero direction, NaN or empty range).
+    pub fn intersect(&self, ray: &Ray<World>) -> Option<Hit> {
+        let r = PlainRay::new(ray)?;
+        let found = match &self.tlas {
+            None if self.items.len() == 1 => self.intersect_item(0, &r, r.t_max),
+            None => None,
+            Some((tlas, order)) => {
+                let top = obvhs::ray::Ray::new(r.o, r.d, r.t_min, r.t_max);
+                let mut ray_hit = RayHit::none();
+                let mut best = None;
+                tlas.ray_traverse(top, &mut ray_hit, |top, slot| {
+                    match self.intersect_item(order[slot] as usize, &r, top.tmax) {
+                        Some(f) => {
+                            best = Some(f);
+                            f.t()
+                        }
+                        None => f32::INFINITY,
+                    }
+                });
+                best
+            }
+        }?;
+        Some(self.finish(&r, found))
+    }
+
+    /// True when anything is hit with `t` in `[t_min, t_max]` (for shadow rays); stops at the
+    /// first hit found.
+    pub fn occluded(&self, ray: &Ray<World>) -> bool {
+        let Some(r) = PlainRay::new(ray) else {
+            return false;
+        };
+        match &self.tlas {
+            None if self.items.len() == 1 => self.occluded_item(0, &r),
+            None => false,
+            Some((tlas, order)) => {
+                let top = obvhs::ray::Ray::new(r.o, r.d, r.t_min, r.t_max);
+                !tlas.ray_traverse_miss(top, |_, slot| {
+                    if self.occluded_item(order[slot] as usize, &r) {
+                        f32::NEG_INFINITY
+                    } else {
+                        f32::INFINITY
+                    }
+                })
+            }
+        }
+    }
+
+    /// The box of everything in the scene, over all times.
+    pub fn bounds(&self) -> Bounds3<World> {
+        self.bounds
+    }
+
+    /// The number of instances added.
+    pub fn instance_count(&self) -> usize {
+        self.meshes.len()
+    }
+
+    /// The closest hit on one item with `t` in `[r.t_min, t_max]`.
+    #[inline]
+    fn intersect_item(&self, item: usize, r: &PlainRay, t_max: f32) -> Option<Found> {
+        match &self.items[item] {
+            Item::Flat => {
+                let (blas, _) = self.flat.as_ref()?;
+                let (slot, tri) = blas.closest(r.o, r.d, r.t_min, t_max)?;
+                Some(Found::Flat { slot, tri })
+            }
+            Item::MovingMesh {
+                blas,
+                world_from_object,
+                ..
+            } => {
+                let object_from_world = world_from_object.at(r.time).inverse();
+                let (o, d) = to_object(&object_from_world, r);
+                let (slot, tri) = self.blases[*blas].closest(o, d, r.t_min, t_max)?;
+                Some(Found::Moving { item, slot, tri })
+            }
+            Item::Analytic { shape, xform, .. } => {
+                let object_from_world = xform.at(r.time).inverse();
+                let (o, d) = to_object(&object_from_world, r);
+                let (o, d) = (Vec3::from(o), Vec3::from(d));
+                match *shape {
+                    Analytic::Sphere { center, radius } => {
+                        let t = intersect_sphere(o, d, r.t_min, t_max, center, radius)?;
+                        Some(Found::Sphere { item, t })
+                    }
+                    Analytic::Quad {
+                        origin,
+                        edge_u,
+                        edge_v,
+                    } => {
+                        let quad = intersect_quad(o, d, r.t_min, t_max, origin, edge_u, edge_v)?;
+                        Some(Found::Quad { item, quad })
+                    }
+                }
+            }
+        }
+    }
+
+    /// True when one item is hit with `t` in `[r.t_min, r.t_max]`.
+    #[inline]
+    fn occluded_item(&self, item: usize, r: &PlainRay) -> bool {
+        match &self.items[item] {
+            Item::Flat => self
+                .flat
+                .as_ref()
+                .is_some_and(|(blas, _)| blas.any(r.o, r.d, r.t_min, r.t_max)),
+            Item::MovingMesh {
+                blas,
+                world_from_object,
+                ..
+            } => {
+                let object_from_world = world_from_object.at(r.time).inverse();
+                let (o, d) = to_object(&object_from_world, r);
+                self.blases[*blas].any(o, d, r.t_min, r.t_max)
+            }
+            Item::Analytic { .. } => self.intersect_item(item, r, r.t_max).is_some(),
+        }
+    }
+
+    /// Builds the full world-space hit record from what the traversal found.
+    fn finish(&self, r: &PlainRay, found: Found) -> Hit {
+        match found {
+            Found::Flat { slot, tri } => {
+                let (blas, ids) = self.flat.as_ref().expect("a flat hit implies flat triangles");
+                let [instance, primitive] = ids[slot];
+                let world_from_object = self.statics[instance as usize]
+                    .expect("flattened meshes are static");
+                let mesh = self.meshes[instance as usize]
+                    .as_ref()
+                    .expect("flattened instances are meshes");
+                let corners = blas.tris[slot].map(Vec3::from);
+                let (p, p_error) = barycentric_point(&corners, tri);
+                // The world corners already carry the transform: (M a) x (M b) =
+                // det(M) M^-T (a x b), so flip for a mirroring transform to match the inverse
+                // transpose of the object-space winding normal.
+                let mut n_geo =
+                    (corners[1] - corners[0]).cross(corners[2] - corners[0]).normalize();
+                if world_from_object.swaps_handedness() {
+                    n_geo = -n_geo;
+                }
+                self.triangle_hit(
+                    r, tri, p, p_error, n_geo, mesh, primitive, instance, &world_from_object,
+                )
+            }
+            Found::Moving { item, slot, tri } => {
+                let Item::MovingMesh {
+                    instance,
+                    blas,
+                    world_from_object,
+                } = &self.items[item]
+                else {
+                    unreachable!("Found::Moving comes from a moving mesh")
+                };
+                let primitive = self.blases[*blas].prims[slot];
+                let mesh = self.meshes[*instance as usize]
+                    .as_ref()
+                    .expect("moving mesh instances are meshes");
+                let world_from_object = world_from_object.at(r.time);
+                let corners = mesh.corners(primitive as usize);
+                let (p_object, err_object) = barycentric_point(&corners, tri);
+                let (p, p_error) =
+                    transform_point_with_error(&world_from_object.matrix(), p_object, err_object);
+                let n_object = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
+                let n_geo = normal_to_world(&world_from_object, n_object);
+                self.triangle_hit(
+                    r, tri, p, p_error, n_geo, mesh, primitive, *instance, &world_from_object,
+                )
+            }
+            Found::Sphere { item, t } => {
+                let (instance, shape, world_from_object) = self.analytic(item, r.time);
+                let Analytic::Sphere { center, radius } = shape else {
+                    unreachable!("Found::Sphere comes from a sphere")
+                };
+                let (o, d) = to_object(&world_from_object.inverse(), r);
+                let p_hit = Vec3::from(o + d * t);
+                // Reproject onto the surface: the error is then that of the projection.
+                let mut rel = p_hit - center;
+                let len = rel.length();
+                rel = if len > 0.0 { rel * (radius / len) } else { Vec3::new(0.0, 0.0, radius) };
+                let p_object = center + rel;
+                let err_object = gamma(5) * rel.abs() + gamma(2) * p_object.abs();
+                let n_object = rel / radius;
+                let theta = (rel.z / radius).clamp(-1.0, 1.0).acos();
+                let mut phi = rel.y.atan2(rel.x);
+                if phi < 0.0 {
+                    phi += 2.0 * core::f32::consts::PI;
+                }
+                let uv = Vec2::new(
+                    phi / (2.0 * core::f32::consts::PI),
+                    theta / core::f32::consts::PI,
+                );
+                self.analytic_hit(
+                    r, t, p_object, err_object, n_object, uv, instance, &world_from_object,
+                )
+            }
+            Found::Quad { item, quad } => {
+                let (instance, shape, world_from_object) = self.analytic(item, r.time);
+                let Analytic::Quad {
+                    origin,
+                    edge_u,
+                    edge_v,
+                } = shape
+                else {
+                    unreachable!("Found::Quad comes from a quad")
+                };
+                let (su, sv) = (edge_u * quad.s, edge_v * quad.v);
+                let p_object = origin + su + sv;
+                let err_object = gamma(5) * (origin.abs() + su.abs() + sv.abs());
+                let n_object = edge_u.cross(edge_v);
+                let uv = Vec2::new(quad.s, quad.v);
+                self.analytic_hit(
+                    r, quad.t, p_object, err_object, n_object, uv, instance, &world_from_object,
+                )
+            }
+        }
+    }
+
+    fn analytic(&self, item: usize, time: f32) -> (u32, Analytic, Transform<World, Object>) {
+        match &self.items[item] {
+            Item::Analytic {
+                instance,
+                shape,
+                xform,
+            } => (*instance, *shape, xform.at(time)),
+            _ => unreachable!("analytic hits come from analytic items"),
+        }
+    }
+
+    fn analytic_hit(
+        &self,
+        r: &PlainRay,
+        t: f32,
+        p_object: Vec3,
+        err_object: Vec3,
+        n_object: Vec3,
+        uv: Vec2,
+        instance: u32,
+        world_from_object: &Transform<World, Object>,
+    ) -> Hit {
+        let (p, p_error) =
+            transform_point_with_error(&world_from_object.matrix(), p_object, err_object);
+        let n = Normal3::from_glam(normal_to_world(world_from_object, n_object));
+        Hit {
+            t,
+            p: Point3::from_glam(p),
+            p_error: Vector3::from_glam(p_error),
+            n_geometric: n,
+            n_shading: n,
+            uv,
+            instance,
+            primitive: 0,
+            time: r.time,
+        }
+    }
+
+    fn triangle_hit(
+        &self,
+        r: &PlainRay,
+        tri: TriangleHit,
+        p: Vec3,
+        p_error: Vec3,
+        n_geo: Vec3,
+        mesh: &TriangleMesh,
+        primitive: u32,
+        instance: u32,
+        world_from_object: &Transform<World, Object>,
+    ) -> Hit {
+        let b = [1.0 - tri.b1 - tri.b2, tri.b1, tri.b2];
+        let vertices = mesh.triangles()[primitive as usize];
+        let n_shading = mesh
+            .normals()
+            .and_then(|normals| {
+                let n_object: Vec3 = (0..3).map(|k| normals[vertices[k] as usize] * b[k]).sum();
+                let n = world_from_object
+                    .normal(Normal3::from_glam(n_object))
+                    .to_glam()
+                    .try_normalize()?;
+                Some(if n.dot(n_geo) < 0.0 { -n } else { n })
+            })
+            .unwrap_or(n_geo);
+        let uv = mesh
+            .uvs()
+            .map(|uvs| (0..3).map(|k| uvs[vertices[k] as usize] * b[k]).sum())
+            .unwrap_or(Vec2::new(tri.b1, tri.b2));
+        Hit {
+            t: tri.t,
+            p: Point3::from_glam(p),
+            p_error: Vector3::from_glam(p_error),
+            n_geometric: Normal3::from_glam(n_geo),
+            n_shading: Normal3::from_glam(n_shading),
+            uv,
+            instance,
+            primitive,
+            time: r.time,
+        }
+    }
+}
+
+/// The ray's origin and direction carried into object space.
+#[inline]
+fn to_object(object_from_world: &Transform<Object, World>, r: &PlainRay) -> (Vec3A, Vec3A) {
+    let m = object_from_world.matrix();
+    (
+        Vec3A::from(m.transform_point3(Vec3::from(r.o))),
+        Vec3A::from(m.transform_vector3(Vec3::from(r.d))),
+    )
+}
+
+/// A unit world normal from an object-space normal, by the inverse transpose.
+#[inline]
+fn normal_to_world(world_from_object: &Transform<World, Object>, n_object: Vec3) -> Vec3 {
+    world_from_object
+        .normal(Normal3::from_glam(n_object))
+        .to_glam()
+        .normalize()
+}
+
+/// The point `b0 p0 + b1 p1 + b2 p2` and pbrt's error bound for it, `gamma(7) sum |b_i p_i|`.
+#[inline]
+fn barycentric_point(corners: &[Vec3; 3], tri: TriangleHit) -> (Vec3, Vec3) {
+    let b = [1.0 - tri.b1 - tri.b2, tri.b1, tri.b2];
+    let terms = [corners[0] * b[0], corners[1] * b[1], corners[2] * b[2]];
+    let p = terms[0] + terms[1] + terms[2];
+    let err = gamma(7) * (terms[0].abs() + terms[1].abs() + terms[2].abs());
+    (p, err)
+}
+
+// The renderer shares one scene between its worker threads.
+const _: () = {
+    const fn assert_send_sync<T: Send + Sync>() {}
+    assert_send_sync::<Scene>();
+};
