@@ -302,8 +302,7 @@ impl PathIntegrator {
             let Some(wi_world) = frame.from_local(bs.wi).try_normalize() else {
                 break;
             };
-            ray = hit.spawn_ray(Vector3::from_glam(wi_world));
-            ray.time = hit.time;
+            ray = spawn_ray(&hit, wi_world);
             depth += 1;
 
             // Russian roulette once the path is a few bounces long.
@@ -346,11 +345,10 @@ impl PathIntegrator {
             return Vec3::ZERO;
         }
         // Shadow ray at the path's own time, so moving occluders cast moving shadows.
-        let mut shadow = match ls.p_light {
-            Some(p_light) => hit.spawn_ray_to(obscura_space::Point3::from_glam(p_light)),
-            None => hit.spawn_ray(Vector3::from_glam(ls.wi)),
+        let shadow = match ls.p_light {
+            Some(p_light) => spawn_ray_to(hit, p_light),
+            None => spawn_ray(hit, ls.wi),
         };
-        shadow.time = hit.time;
         if geometry.occluded(&shadow) {
             return Vec3::ZERO;
         }
@@ -373,4 +371,40 @@ fn shading_frame(hit: &Hit, material: &Material, wo_world: Vec3) -> Frame {
         n_shading = -n_shading;
     }
     Frame::from_normal(n_shading.try_normalize().unwrap_or(Vec3::Z))
+}
+
+/// The offset used when the accelerator's error bound along the normal is exactly zero (a
+/// surface lying on a coordinate plane, e.g. a floor at `y = 0`): a few ulps of the point's
+/// largest coordinate, so the spawned ray cannot re-hit its own surface at `t = 0`.
+fn fallback_offset(hit: &Hit, w: Vec3) -> Option<Vec3> {
+    let p = hit.p.to_glam();
+    let n = hit.n_geometric.to_glam();
+    if n.abs().dot(hit.p_error.to_glam().abs()) > 0.0 {
+        return None;
+    }
+    let d = 1e-6 * (1.0 + p.abs().max_element());
+    Some(if w.dot(n) < 0.0 { p - n * d } else { p + n * d })
+}
+
+/// A ray leaving `hit` along `direction` at the hit's time (the path's own time).
+fn spawn_ray(hit: &Hit, direction: Vec3) -> Ray<World> {
+    let mut ray = hit.spawn_ray(Vector3::from_glam(direction));
+    if let Some(origin) = fallback_offset(hit, direction) {
+        ray.origin = obscura_space::Point3::from_glam(origin);
+    }
+    ray.time = hit.time;
+    ray
+}
+
+/// A shadow ray from `hit` to `target`, stopping just short of it, at the hit's time.
+fn spawn_ray_to(hit: &Hit, target: Vec3) -> Ray<World> {
+    let target_point = obscura_space::Point3::from_glam(target);
+    let mut ray = hit.spawn_ray_to(target_point);
+    if let Some(origin) = fallback_offset(hit, target - hit.p.to_glam()) {
+        let origin = obscura_space::Point3::from_glam(origin);
+        ray = Ray::new(origin, target_point - origin, hit.time)
+            .with_range(0.0, 1.0 - obscura_accel::SHADOW_EPSILON);
+    }
+    ray.time = hit.time;
+    ray
 }

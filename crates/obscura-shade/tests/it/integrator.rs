@@ -1,0 +1,484 @@
+//! The path tracer against analytic answers: white furnace, inverse square, area light form
+//! factor through MIS, mirror geometry, moving shadows, convergence rate, MIS weights.
+
+use crate::{Rng, mean_and_error};
+use core::f32::consts::{FRAC_1_PI, PI};
+use glam::{Vec2, Vec3};
+use obscura_accel::{Placement, Scene, SceneBuilder, Shape};
+use obscura_shade::{
+    EnvironmentLight, Light, Material, PathIntegrator, ShadingScene, power_heuristic,
+};
+use obscura_space::{AnimatedTransform, Object, Point3, Ray, Transform, Vector3, World};
+use proptest::prelude::*;
+
+fn fixed() -> Placement {
+    Placement::Static(Transform::IDENTITY)
+}
+
+fn ray(origin: Vec3, direction: Vec3, time: f32) -> Ray<World> {
+    Ray::new(
+        Point3::from_glam(origin),
+        Vector3::from_glam(direction.normalize()),
+        time,
+    )
+}
+
+/// One shape per instance: (shape, placement, material, emission).
+fn build(
+    items: Vec<(Shape, Placement, Material, Vec3)>,
+    lights: Vec<Light>,
+) -> (Scene, ShadingScene) {
+    let mut builder = SceneBuilder::new();
+    let mut materials = Vec::new();
+    let mut instance_material = Vec::new();
+    let mut emitters = Vec::new();
+    for (shape, placement, material, emission) in items {
+        let instance = builder.add(shape.clone(), placement.clone()).unwrap();
+        instance_material.push(materials.len() as u32);
+        materials.push(material);
+        if emission != Vec3::ZERO {
+            emitters.push((instance, shape, placement, emission));
+        }
+    }
+    let shading = ShadingScene::new(materials, instance_material, lights, emitters).unwrap();
+    (builder.build().unwrap(), shading)
+}
+
+fn estimate(
+    integrator: &PathIntegrator,
+    scene: &(Scene, ShadingScene),
+    r: &Ray<World>,
+    n: usize,
+    seed: u64,
+) -> (f64, f64) {
+    let mut rng = Rng::new(seed);
+    let values: Vec<f64> = (0..n)
+        .map(|_| {
+            let l = integrator.li(&scene.0, &scene.1, r, &mut rng);
+            assert!(l.is_finite() && l.min_element() >= 0.0, "{l}");
+            l.x as f64
+        })
+        .collect();
+    mean_and_error(&values)
+}
+
+fn white() -> Material {
+    Material::Diffuse {
+        reflectance: Vec3::ONE,
+    }
+}
+
+fn furnace(items: Vec<(Shape, Placement, Material, Vec3)>, label: &str) {
+    // Radiance 1 everywhere is the solution of the rendering equation when every surface is
+    // lossless and the environment is uniform 1, so every pixel must average to 1. Bound: the
+    // mean of N = 2000 paths lies within 4.5 standard errors (estimated from the paths
+    // themselves) of 1, for each of 12 directions; that fails by chance with probability
+    // about 12 * 7e-6.
+    let scene = build(
+        items,
+        vec![Light::Environment(
+            EnvironmentLight::constant(Vec3::ONE).unwrap(),
+        )],
+    );
+    let integrator = PathIntegrator::new(100);
+    let mut rng = Rng::new(77);
+    for k in 0..12 {
+        let origin = rng.direction() * 6.0;
+        let target = rng.direction() * 0.5;
+        let r = ray(origin, target - origin, 0.0);
+        let (m, e) = estimate(&integrator, &scene, &r, 2000, k);
+        assert!(
+            (m - 1.0).abs() <= 4.5 * e + 1e-4,
+            "{label}: direction {k}: {m} +- {e}"
+        );
+    }
+}
+
+#[test]
+fn white_furnace_diffuse_sphere() {
+    furnace(
+        vec![(
+            Shape::Sphere {
+                center: Vec3::ZERO,
+                radius: 1.0,
+            },
+            fixed(),
+            white(),
+            Vec3::ZERO,
+        )],
+        "diffuse sphere",
+    );
+}
+
+#[test]
+fn white_furnace_interreflecting_spheres_and_glass() {
+    // Two touching white spheres reflect light between them (long paths, Russian roulette),
+    // and a glass sphere refracts it through (1/eta^2 in, eta^2 out): still radiance 1.
+    furnace(
+        vec![
+            (
+                Shape::Sphere {
+                    center: Vec3::new(-1.0, 0.0, 0.0),
+                    radius: 1.0,
+                },
+                fixed(),
+                white(),
+                Vec3::ZERO,
+            ),
+            (
+                Shape::Sphere {
+                    center: Vec3::new(1.0, 0.0, 0.0),
+                    radius: 1.0,
+                },
+                fixed(),
+                white(),
+                Vec3::ZERO,
+            ),
+            (
+                Shape::Sphere {
+                    center: Vec3::new(0.0, 1.8, 0.0),
+                    radius: 0.7,
+                },
+                fixed(),
+                Material::Dielectric { ior: 1.5 },
+                Vec3::ZERO,
+            ),
+        ],
+        "spheres",
+    );
+}
+
+fn floor(material: Material) -> (Shape, Placement, Material, Vec3) {
+    // A 20 x 20 quad at y = 0 facing +y: cross((0, 0, 20), (20, 0, 0)) = (0, 400, 0).
+    (
+        Shape::Quad {
+            origin: Vec3::new(-10.0, 0.0, -10.0),
+            edge_u: Vec3::new(0.0, 0.0, 20.0),
+            edge_v: Vec3::new(20.0, 0.0, 0.0),
+        },
+        fixed(),
+        material,
+        Vec3::ZERO,
+    )
+}
+
+#[test]
+fn point_light_inverse_square_is_exact() {
+    // rho = 0.5, I = 10, h = 2: L = rho / pi * I / h^2 = 0.5 / pi * 2.5 = 0.397887.
+    let rho = 0.5;
+    let scene = build(
+        vec![floor(Material::Diffuse {
+            reflectance: Vec3::splat(rho),
+        })],
+        vec![Light::point(Vec3::new(0.3, 2.0, -0.4), Vec3::splat(10.0)).unwrap()],
+    );
+    let expected = rho * FRAC_1_PI * 10.0 / 4.0;
+    // The camera ray looks straight down at the foot of the light (from below the light).
+    let r = ray(Vec3::new(0.3, 1.0, -0.4), Vec3::NEG_Y, 0.0);
+    for max_depth in [1, 5] {
+        let mut rng = Rng::new(1);
+        for _ in 0..20 {
+            let l = PathIntegrator::new(max_depth).li(&scene.0, &scene.1, &r, &mut rng);
+            assert!(
+                (l.x - expected).abs() <= 1e-5 * expected,
+                "{} vs {expected}",
+                l.x
+            );
+        }
+    }
+    // Off the foot, at horizontal distance 2: r^2 = 8, cos = 2 / sqrt(8): L = rho/pi I cos / r^2.
+    let r = ray(Vec3::new(2.3, 1.0, -0.4), Vec3::NEG_Y, 0.0);
+    let l = PathIntegrator::new(1).li(&scene.0, &scene.1, &r, &mut Rng::new(2));
+    let expected = rho * FRAC_1_PI * 10.0 * (2.0 / 8f32.sqrt()) / 8.0;
+    assert!((l.x - expected).abs() <= 1e-5 * expected);
+    // max_depth 0 sees no light at all (only emitters).
+    assert_eq!(
+        PathIntegrator::new(0).li(&scene.0, &scene.1, &r, &mut Rng::new(3)),
+        Vec3::ZERO
+    );
+}
+
+#[test]
+fn distant_light_irradiance() {
+    // Irradiance 3 along a direction 60 degrees from the normal: E cos = 1.5, L = rho/pi 1.5.
+    let d = Vec3::new((60f32).to_radians().sin(), -(60f32).to_radians().cos(), 0.0);
+    let scene = build(
+        vec![floor(Material::Diffuse {
+            reflectance: Vec3::splat(0.8),
+        })],
+        vec![Light::distant(d, Vec3::splat(3.0)).unwrap()],
+    );
+    let l = PathIntegrator::new(3).li(
+        &scene.0,
+        &scene.1,
+        &ray(Vec3::new(0.0, 1.0, 0.0), Vec3::new(0.1, -1.0, 0.0), 0.0),
+        &mut Rng::new(4),
+    );
+    assert!((l.x - 0.8 * FRAC_1_PI * 1.5).abs() < 1e-5, "{}", l.x);
+}
+
+/// A floor of albedo rho under a 2 x 3 quad light of radiance 4 at height 1.5 with a corner
+/// straight above the origin: the radiance leaving the origin, with max_depth 1, is
+/// rho / pi * E where E is the rectangle's form factor formula.
+fn area_light_scene() -> ((Scene, ShadingScene), f64) {
+    let light_quad = Shape::Quad {
+        origin: Vec3::new(0.0, 1.5, 0.0),
+        edge_u: Vec3::new(2.0, 0.0, 0.0),
+        edge_v: Vec3::new(0.0, 0.0, 3.0),
+    };
+    let scene = build(
+        vec![
+            floor(Material::Diffuse {
+                reflectance: Vec3::splat(0.5),
+            }),
+            (
+                light_quad,
+                fixed(),
+                Material::Diffuse {
+                    reflectance: Vec3::ZERO,
+                },
+                Vec3::splat(4.0),
+            ),
+        ],
+        vec![],
+    );
+    // E = L/2 [X/sqrt(1+X^2) atan(Y/sqrt(1+X^2)) + Y/sqrt(1+Y^2) atan(X/sqrt(1+Y^2))], X = 2/1.5, Y = 3/1.5.
+    let (x, y) = (2.0f64 / 1.5, 3.0f64 / 1.5);
+    let (sx, sy) = ((1.0 + x * x).sqrt(), (1.0 + y * y).sqrt());
+    let e = 0.5 * 4.0 * (x / sx * (y / sx).atan() + y / sy * (x / sy).atan());
+    (scene, 0.5 / PI as f64 * e)
+}
+
+#[test]
+fn area_light_through_mis_is_unbiased() {
+    let (scene, expected) = area_light_scene();
+    let r = ray(Vec3::new(-0.5, 1.0, -0.5), Vec3::new(0.5, -1.0, 0.5), 0.0);
+    let (m, e) = estimate(&PathIntegrator::new(1), &scene, &r, 20_000, 5);
+    assert!((m - expected).abs() <= 4.0 * e, "{m} +- {e} vs {expected}");
+    // The emitter seen directly from below shows its radiance; from above (its back) nothing.
+    let below = PathIntegrator::new(0).li(
+        &scene.0,
+        &scene.1,
+        &ray(Vec3::new(1.0, 1.0, 1.0), Vec3::Y, 0.0),
+        &mut Rng::new(1),
+    );
+    assert_eq!(below, Vec3::splat(4.0));
+    let above = PathIntegrator::new(0).li(
+        &scene.0,
+        &scene.1,
+        &ray(Vec3::new(1.0, 2.0, 1.0), Vec3::NEG_Y, 0.0),
+        &mut Rng::new(1),
+    );
+    assert_eq!(above, Vec3::ZERO);
+}
+
+#[test]
+fn error_falls_as_one_over_sqrt_spp() {
+    // RMS error against the analytic value over 200 independent pixel estimates at 4 and 64
+    // samples: 16 times the samples should give a quarter of the error. Accept a ratio in
+    // [3, 5.3] (the RMS of 200 estimates is itself uncertain by about 5%).
+    let (scene, expected) = area_light_scene();
+    let r = ray(Vec3::new(-0.5, 1.0, -0.5), Vec3::new(0.5, -1.0, 0.5), 0.0);
+    let integrator = PathIntegrator::new(1);
+    let rms = |spp: usize, seed: u64| {
+        let mut rng = Rng::new(seed);
+        let mut sum = 0.0f64;
+        for _ in 0..200 {
+            let mean: f64 = (0..spp)
+                .map(|_| integrator.li(&scene.0, &scene.1, &r, &mut rng).x as f64)
+                .sum::<f64>()
+                / spp as f64;
+            sum += (mean - expected) * (mean - expected);
+        }
+        (sum / 200.0).sqrt()
+    };
+    let (coarse, fine) = (rms(4, 100), rms(64, 200));
+    let ratio = coarse / fine;
+    assert!(
+        (3.0..=5.3).contains(&ratio),
+        "rms {coarse} at 4 spp, {fine} at 64 spp: ratio {ratio}"
+    );
+}
+
+#[test]
+fn a_mirror_shows_the_reflected_object_where_geometry_says() {
+    // A mirror floor at y = 0 and an emissive sphere (radius 0.5, radiance 2) centred at
+    // (2, 1, 0). A ray from (-2, 1, 0) aimed at the floor point (0, 0, 0) reflects to
+    // direction (2, 1, 0), which passes through the sphere's centre at t = 1: we see 0.9 * 2.
+    // Aimed at (0, 0, 1.0) it reflects along (2, 1, 1), passing the centre at
+    // distance sqrt(10/3) = 1.83 > 0.5: black.
+    let scene = build(
+        vec![
+            floor(Material::Mirror {
+                reflectance: Vec3::splat(0.9),
+            }),
+            (
+                Shape::Sphere {
+                    center: Vec3::new(2.0, 1.0, 0.0),
+                    radius: 0.5,
+                },
+                fixed(),
+                white(),
+                Vec3::splat(2.0),
+            ),
+        ],
+        vec![],
+    );
+    let integrator = PathIntegrator::new(4);
+    let hit = integrator.li(
+        &scene.0,
+        &scene.1,
+        &ray(Vec3::new(-2.0, 1.0, 0.0), Vec3::new(2.0, -1.0, 0.0), 0.0),
+        &mut Rng::new(1),
+    );
+    assert!((hit - Vec3::splat(1.8)).abs().max_element() < 1e-5, "{hit}");
+    let miss = integrator.li(
+        &scene.0,
+        &scene.1,
+        &ray(Vec3::new(-2.0, 1.0, 0.0), Vec3::new(2.0, -1.0, 1.0), 0.0),
+        &mut Rng::new(1),
+    );
+    // Only the floor's reflection of nothing: no environment, and the mirror does not sample lights.
+    assert_eq!(miss, Vec3::ZERO);
+}
+
+#[test]
+fn a_moving_occluder_casts_a_moving_shadow() {
+    // A point light at height 4 above the origin; a 1 x 1 occluder quad at height 2 moving
+    // along x from x = -3 to x = +1 (its left edge) over time [0, 1]. Its shadow on the floor
+    // has twice its size and position (similar triangles, factor 4/2): the shadow covers
+    // x in [2 (-3 + 4t), 2 (-2 + 4t)] = [-6 + 8t, -4 + 8t], z in [-1, 1].
+    let start = Transform::<World, Object>::translate(Vec3::new(-3.0, 2.0, -0.5)).unwrap();
+    let end = Transform::<World, Object>::translate(Vec3::new(1.0, 2.0, -0.5)).unwrap();
+    let occluder = (
+        Shape::Quad {
+            origin: Vec3::ZERO,
+            edge_u: Vec3::new(0.0, 0.0, 1.0),
+            edge_v: Vec3::new(1.0, 0.0, 0.0),
+        },
+        Placement::Moving(AnimatedTransform::new(start, 0.0, end, 1.0).unwrap()),
+        white(),
+        Vec3::ZERO,
+    );
+    let scene = build(
+        vec![floor(white()), occluder],
+        vec![Light::point(Vec3::new(0.0, 4.0, 0.0), Vec3::splat(16.0)).unwrap()],
+    );
+    let integrator = PathIntegrator::new(1);
+    let radiance = |x: f32, time: f32| {
+        let r = ray(Vec3::new(x, 0.5, 0.0), Vec3::NEG_Y, time);
+        integrator.li(&scene.0, &scene.1, &r, &mut Rng::new(1)).x
+    };
+    // At time t the floor point x is dark exactly when -6 + 8t < x < -4 + 8t.
+    for (x, time, dark) in [
+        (-5.0, 0.0, true),
+        (-5.0, 0.5, false),
+        (-1.0, 0.5, true),
+        (3.0, 1.0, true),
+        (3.0, 0.5, false),
+        (-1.0, 0.0, false),
+    ] {
+        let l = radiance(x, time);
+        assert_eq!(l == 0.0, dark, "x {x} time {time}: radiance {l}");
+    }
+    // Averaged over the shutter, the shadow is blurred: at x = -1 the point is dark for
+    // t in (5/8, 3/8 + ...): -6 + 8t < -1 < -4 + 8t  <=>  3/8 < t < 5/8, a quarter of the time.
+    let n = 4000;
+    let mut rng = Rng::new(9);
+    let dark = (0..n)
+        .filter(|_| radiance(-1.0, rng.uniform()) == 0.0)
+        .count();
+    let fraction = dark as f64 / n as f64;
+    // Binomial standard deviation sqrt(0.25 * 0.75 / 4000) = 0.0068; allow 4.5 of them.
+    assert!((fraction - 0.25).abs() < 0.031, "{fraction}");
+}
+
+#[test]
+fn radiance_is_always_finite() {
+    // Every material and light together, rays in every direction, grazing included.
+    let mut texels = vec![Vec3::splat(0.5); 8 * 4];
+    texels[5] = Vec3::splat(1e4);
+    let env = EnvironmentLight::from_texels(8, 4, texels, glam::Mat4::IDENTITY).unwrap();
+    let scene = build(
+        vec![
+            floor(Material::RoughConductor {
+                reflectance: Vec3::splat(0.9),
+                roughness: 0.3,
+            }),
+            (
+                Shape::Sphere {
+                    center: Vec3::new(0.0, 1.0, 0.0),
+                    radius: 1.0,
+                },
+                fixed(),
+                Material::Dielectric { ior: 1.5 },
+                Vec3::ZERO,
+            ),
+            (
+                Shape::Sphere {
+                    center: Vec3::new(2.5, 1.0, 0.0),
+                    radius: 1.0,
+                },
+                fixed(),
+                Material::Mirror {
+                    reflectance: Vec3::ONE,
+                },
+                Vec3::ZERO,
+            ),
+            (
+                Shape::Sphere {
+                    center: Vec3::new(-2.5, 1.0, 0.0),
+                    radius: 1.0,
+                },
+                fixed(),
+                white(),
+                Vec3::splat(3.0),
+            ),
+            (
+                Shape::Quad {
+                    origin: Vec3::new(-1.0, 4.0, -1.0),
+                    edge_u: Vec3::new(2.0, 0.0, 0.0),
+                    edge_v: Vec3::new(0.0, 0.0, 2.0),
+                },
+                fixed(),
+                Material::RoughConductor {
+                    reflectance: Vec3::ONE,
+                    roughness: 0.0,
+                },
+                Vec3::splat(5.0),
+            ),
+        ],
+        vec![
+            Light::point(Vec3::new(0.0, 3.0, 2.0), Vec3::splat(5.0)).unwrap(),
+            Light::distant(Vec3::new(1.0, -1.0, 0.0), Vec3::ONE).unwrap(),
+            Light::Environment(env),
+        ],
+    );
+    let integrator = PathIntegrator::new(12);
+    let mut rng = Rng::new(31);
+    for _ in 0..3000 {
+        let origin = rng.direction() * 5.0 + Vec3::new(0.0, 5.0, 0.0);
+        let r = ray(origin, rng.direction(), rng.uniform());
+        let l = integrator.li(&scene.0, &scene.1, &r, &mut rng);
+        assert!(l.is_finite() && l.min_element() >= 0.0, "{l}");
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(1000))]
+    #[test]
+    fn mis_weights_sum_to_one(a in 0.0f32..1e6, b in 0.0f32..1e6) {
+        prop_assume!(a > 0.0 || b > 0.0);
+        let sum = power_heuristic(a, b) + power_heuristic(b, a);
+        prop_assert!((sum - 1.0).abs() < 1e-5, "{}", sum);
+    }
+}
+
+#[test]
+fn mis_weight_hand_values() {
+    // pdfs 1 and 3: 1 / (1 + 9) = 0.1 and 9 / 10 = 0.9.
+    assert!((power_heuristic(1.0, 3.0) - 0.1).abs() < 1e-7);
+    assert!((power_heuristic(3.0, 1.0) - 0.9).abs() < 1e-7);
+    assert_eq!(power_heuristic(2.0, 0.0), 1.0);
+    let _ = Vec2::ZERO;
+}
