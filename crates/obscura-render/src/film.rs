@@ -1,0 +1,373 @@
+//! The film: reconstruction filters, per-tile accumulation and the final pixel values.
+//!
+//! Every sample is splatted into each pixel whose filter support holds it, with the filter's
+//! weight. A pixel's value is the weighted mean of its samples' radiance (misses count as 0),
+//! and its alpha the weighted fraction of samples whose camera ray hit geometry.
+//!
+//! Tiles accumulate into their own buffers (their pixels plus a margin as wide as the filter)
+//! and are merged into the film in tile order, so the sums, and the image, are bit-identical
+//! whatever the number of threads or the order tiles finish in.
+
+use crate::scene::FilterSettings;
+use glam::{Vec2, Vec3};
+
+/// A separable reconstruction filter `f(dx) f(dy)`, with `dx`, `dy` in pixels from the pixel's
+/// centre.
+#[derive(Clone, Copy, Debug)]
+pub struct Filter {
+    settings: FilterSettings,
+    /// For the Gaussian: `exp(-r^2 / (2 sigma^2))`, subtracted so the filter reaches 0 at r.
+    gaussian_floor: f32,
+}
+
+impl Filter {
+    /// A filter from validated settings.
+    pub fn new(settings: FilterSettings) -> Self {
+        let r = settings.radius();
+        let sigma = r / 3.0;
+        Self {
+            settings,
+            gaussian_floor: (-(r * r) / (2.0 * sigma * sigma)).exp(),
+        }
+    }
+
+    /// The radius of support in pixels.
+    pub fn radius(&self) -> f32 {
+        self.settings.radius()
+    }
+
+    /// The one-dimensional profile at offset `d` (zero outside the support).
+    pub fn eval_1d(&self, d: f32) -> f32 {
+        let r = self.radius();
+        let a = d.abs();
+        if a >= r {
+            // The box includes -r but not +r, so that every point falls in exactly one pixel.
+            return if matches!(self.settings, FilterSettings::Box { .. }) && d == -r {
+                1.0
+            } else {
+                0.0
+            };
+        }
+        match self.settings {
+            FilterSettings::Box { .. } => 1.0,
+            FilterSettings::Triangle { .. } => 1.0 - a / r,
+            FilterSettings::Gaussian { .. } => {
+                let sigma = r / 3.0;
+                ((-(a * a) / (2.0 * sigma * sigma)).exp() - self.gaussian_floor).max(0.0)
+            }
+            FilterSettings::Mitchell { .. } => mitchell(2.0 * a / r),
+        }
+    }
+
+    /// The weight of a sample at offset `d` from a pixel centre.
+    pub fn eval(&self, d: Vec2) -> f32 {
+        self.eval_1d(d.x) * self.eval_1d(d.y)
+    }
+}
+
+/// Mitchell-Netravali with B = C = 1/3 on x in [0, 2].
+fn mitchell(x: f32) -> f32 {
+    const B: f32 = 1.0 / 3.0;
+    const C: f32 = 1.0 / 3.0;
+    let x2 = x * x;
+    let x3 = x2 * x;
+    if x < 1.0 {
+        ((12.0 - 9.0 * B - 6.0 * C) * x3 + (-18.0 + 12.0 * B + 6.0 * C) * x2 + (6.0 - 2.0 * B))
+            / 6.0
+    } else if x < 2.0 {
+        ((-B - 6.0 * C) * x3
+            + (6.0 * B + 30.0 * C) * x2
+            + (-12.0 * B - 48.0 * C) * x
+            + (8.0 * B + 24.0 * C))
+            / 6.0
+    } else {
+        0.0
+    }
+}
+
+/// The running sums of one pixel. f64, so that long renders and resumed renders add exactly.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PixelSums {
+    /// Sum of weight times radiance.
+    pub radiance: [f64; 3],
+    /// Sum of weights.
+    pub weight: f64,
+    /// Sum of weights of samples whose camera ray hit geometry.
+    pub coverage: f64,
+}
+
+impl PixelSums {
+    fn add(&mut self, o: &PixelSums) {
+        for c in 0..3 {
+            self.radiance[c] += o.radiance[c];
+        }
+        self.weight += o.weight;
+        self.coverage += o.coverage;
+    }
+
+    /// The pixel's value: weighted mean radiance and coverage, (0, 0, 0, 0) with no weight.
+    pub fn resolve(&self) -> [f32; 4] {
+        if self.weight == 0.0 {
+            return [0.0; 4];
+        }
+        let inv = 1.0 / self.weight;
+        [
+            (self.radiance[0] * inv) as f32,
+            (self.radiance[1] * inv) as f32,
+            (self.radiance[2] * inv) as f32,
+            (self.coverage * inv) as f32,
+        ]
+    }
+}
+
+/// A rectangle of pixels `[x0, x1) x [y0, y1)`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PixelRect {
+    /// First column.
+    pub x0: u32,
+    /// First row.
+    pub y0: u32,
+    /// One past the last column.
+    pub x1: u32,
+    /// One past the last row.
+    pub y1: u32,
+}
+
+impl PixelRect {
+    /// Width in pixels.
+    pub fn width(&self) -> u32 {
+        self.x1 - self.x0
+    }
+    /// Height in pixels.
+    pub fn height(&self) -> u32 {
+        self.y1 - self.y0
+    }
+    /// Number of pixels.
+    pub fn area(&self) -> u64 {
+        u64::from(self.width()) * u64::from(self.height())
+    }
+}
+
+/// One tile's sums: the tile's pixels and a filter-wide margin, clipped to the film.
+pub struct TileBuffer {
+    rect: PixelRect,
+    filter: Filter,
+    sums: Vec<PixelSums>,
+}
+
+impl TileBuffer {
+    /// A zeroed buffer for samples of the pixels in `tile`, on a film covering `film`.
+    pub fn new(tile: PixelRect, film: PixelRect, filter: Filter) -> Self {
+        let m = filter.radius().ceil() as u32;
+        let rect = PixelRect {
+            x0: tile.x0.saturating_sub(m).max(film.x0),
+            y0: tile.y0.saturating_sub(m).max(film.y0),
+            x1: (tile.x1 + m).min(film.x1),
+            y1: (tile.y1 + m).min(film.y1),
+        };
+        Self {
+            rect,
+            filter,
+            sums: vec![PixelSums::default(); rect.area() as usize],
+        }
+    }
+
+    /// Adds a sample at raster position `p` with radiance `l` into every pixel the filter
+    /// reaches. `hit` says whether its camera ray hit geometry.
+    pub fn add_sample(&mut self, p: Vec2, l: Vec3, hit: bool) {
+        let r = self.filter.radius();
+        // Pixels whose centre i + 0.5 lies in (p - r, p + r].
+        let lo = ((p - Vec2::splat(r + 0.5)).floor() + Vec2::ONE)
+            .max(Vec2::new(self.rect.x0 as f32, self.rect.y0 as f32));
+        let hi = (p + Vec2::splat(r - 0.5)).floor().min(Vec2::new(
+            self.rect.x1 as f32 - 1.0,
+            self.rect.y1 as f32 - 1.0,
+        ));
+        if lo.x > hi.x || lo.y > hi.y {
+            return;
+        }
+        let (l, coverage) = (l.as_dvec3(), if hit { 1.0 } else { 0.0 });
+        for y in lo.y as u32..=hi.y as u32 {
+            let wy = self.filter.eval_1d(p.y - (y as f32 + 0.5));
+            if wy == 0.0 {
+                continue;
+            }
+            for x in lo.x as u32..=hi.x as u32 {
+                let w = f64::from(wy * self.filter.eval_1d(p.x - (x as f32 + 0.5)));
+                if w == 0.0 {
+                    continue;
+                }
+                let i = ((y - self.rect.y0) * self.rect.width() + (x - self.rect.x0)) as usize;
+                let s = &mut self.sums[i];
+                s.radiance[0] += w * l.x;
+                s.radiance[1] += w * l.y;
+                s.radiance[2] += w * l.z;
+                s.weight += w;
+                s.coverage += w * coverage;
+            }
+        }
+    }
+}
+
+/// The whole film's sums over its pixel bounds (the crop window).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Film {
+    bounds: PixelRect,
+    sums: Vec<PixelSums>,
+}
+
+impl Film {
+    /// A zeroed film covering `bounds`.
+    pub fn new(bounds: PixelRect) -> Self {
+        Self {
+            bounds,
+            sums: vec![PixelSums::default(); bounds.area() as usize],
+        }
+    }
+
+    /// The pixels this film covers.
+    pub fn bounds(&self) -> PixelRect {
+        self.bounds
+    }
+
+    /// The sums, row by row over [`Film::bounds`].
+    pub fn sums(&self) -> &[PixelSums] {
+        &self.sums
+    }
+
+    /// A film from saved sums (a checkpoint); `None` if the count does not match.
+    pub fn from_sums(bounds: PixelRect, sums: Vec<PixelSums>) -> Option<Self> {
+        (sums.len() as u64 == bounds.area()).then_some(Self { bounds, sums })
+    }
+
+    /// Adds a tile's sums. Merge tiles in a fixed order for bit-identical results.
+    pub fn merge(&mut self, tile: &TileBuffer) {
+        let t = tile.rect;
+        for y in t.y0..t.y1 {
+            for x in t.x0..t.x1 {
+                let src = &tile.sums[((y - t.y0) * t.width() + (x - t.x0)) as usize];
+                let dst =
+                    ((y - self.bounds.y0) * self.bounds.width() + (x - self.bounds.x0)) as usize;
+                self.sums[dst].add(src);
+            }
+        }
+    }
+
+    /// The image: RGBA per pixel, row 0 at the top.
+    pub fn resolve(&self) -> Image {
+        Image {
+            width: self.bounds.width(),
+            height: self.bounds.height(),
+            pixels: self.sums.iter().map(PixelSums::resolve).collect(),
+        }
+    }
+}
+
+/// A finished image of linear RGBA floats, row-major, row 0 at the top.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Image {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// `width * height` RGBA values.
+    pub pixels: Vec<[f32; 4]>,
+}
+
+impl Image {
+    /// The pixel at column `x`, row `y`.
+    pub fn pixel(&self, x: u32, y: u32) -> [f32; 4] {
+        self.pixels[(y * self.width + x) as usize]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn film_rect(w: u32, h: u32) -> PixelRect {
+        PixelRect {
+            x0: 0,
+            y0: 0,
+            x1: w,
+            y1: h,
+        }
+    }
+
+    #[test]
+    fn box_filter_puts_each_sample_in_exactly_one_pixel() {
+        let filter = Filter::new(FilterSettings::Box { radius: 0.5 });
+        let mut tile = TileBuffer::new(film_rect(4, 4), film_rect(4, 4), filter);
+        // On the boundary between pixels 1 and 2 (x = 2.0): it belongs to pixel 2 only.
+        tile.add_sample(Vec2::new(2.0, 1.5), Vec3::ONE, true);
+        let mut film = Film::new(film_rect(4, 4));
+        film.merge(&tile);
+        let touched: Vec<(usize, f64)> = film
+            .sums()
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| s.weight > 0.0)
+            .map(|(i, s)| (i, s.weight))
+            .collect();
+        assert_eq!(touched, vec![(4 + 2, 1.0)]);
+    }
+
+    #[test]
+    fn pixel_value_is_the_weighted_mean_and_alpha_the_coverage() {
+        // Two samples in pixel (0, 0) with the box filter: radiance 1 (hit) and 0 (miss).
+        let filter = Filter::new(FilterSettings::Box { radius: 0.5 });
+        let mut tile = TileBuffer::new(film_rect(1, 1), film_rect(1, 1), filter);
+        tile.add_sample(Vec2::new(0.25, 0.25), Vec3::new(1.0, 2.0, 3.0), true);
+        tile.add_sample(Vec2::new(0.75, 0.75), Vec3::ZERO, false);
+        let mut film = Film::new(film_rect(1, 1));
+        film.merge(&tile);
+        assert_eq!(film.resolve().pixel(0, 0), [0.5, 1.0, 1.5, 0.5]);
+    }
+
+    #[test]
+    fn filters_fall_to_zero_at_their_radius_and_peak_at_the_centre() {
+        for settings in [
+            FilterSettings::Triangle { radius: 1.0 },
+            FilterSettings::Gaussian { radius: 1.5 },
+            FilterSettings::Mitchell { radius: 2.0 },
+        ] {
+            let f = Filter::new(settings);
+            let r = f.radius();
+            assert_eq!(f.eval_1d(r), 0.0, "{settings:?}");
+            assert!(f.eval_1d(r * 0.999).abs() < 1e-3, "{settings:?}");
+            assert!(f.eval_1d(0.0) > f.eval_1d(r * 0.3), "{settings:?}");
+        }
+        // Triangle at half its radius: 1 - 0.5 = 0.5. Mitchell at 0: (6 - 2/3) / 6 = 8/9.
+        assert_eq!(
+            Filter::new(FilterSettings::Triangle { radius: 1.0 }).eval_1d(0.5),
+            0.5
+        );
+        assert!(
+            (Filter::new(FilterSettings::Mitchell { radius: 2.0 }).eval_1d(0.0) - 8.0 / 9.0).abs()
+                < 1e-6
+        );
+    }
+
+    #[test]
+    fn wide_filters_reach_neighbouring_tiles_through_the_margin() {
+        let filter = Filter::new(FilterSettings::Gaussian { radius: 1.5 });
+        let film_r = film_rect(8, 8);
+        let mut tile = TileBuffer::new(
+            PixelRect {
+                x0: 4,
+                y0: 4,
+                x1: 8,
+                y1: 8,
+            },
+            film_r,
+            filter,
+        );
+        tile.add_sample(Vec2::new(4.1, 4.1), Vec3::ONE, true);
+        let mut film = Film::new(film_r);
+        film.merge(&tile);
+        // Pixel (3, 3), centre (3.5, 3.5), is 0.6 away on each axis: inside the radius.
+        assert!(film.sums()[3 * 8 + 3].weight > 0.0);
+        // Pixel (2, 2), centre (2.5, 2.5), is 1.6 away: outside.
+        assert_eq!(film.sums()[2 * 8 + 2].weight, 0.0);
+    }
+}
