@@ -147,25 +147,43 @@ pub(crate) fn transform_point_with_error(m: &Mat4, p: Vec3, p_error: Vec3) -> (V
     (p_out, rounding + carried)
 }
 
+/// The smallest distance [`offset_ray_origin`] moves a point off its surface.
+const MIN_OFFSET: f32 = 1e-20;
+
 /// Moves `p` off a surface with normal `n` by its error bound `p_error`, to the side `w`
 /// points to, then one ulp further away, so a ray from the result cannot re-hit the surface
 /// it starts on (pbrt-v4's `OffsetRayOrigin`).
 pub(crate) fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec3 {
-    let d = n.abs().dot(p_error);
+    // At least 1e-20: a surface with exact coordinates (a quad in the plane z = 0) has a zero
+    // error bound, and an origin left exactly on it would meet it again at t = -0 = 0.
+    let d = n.abs().dot(p_error).max(MIN_OFFSET);
     let mut offset = n * d;
     if w.dot(n) < 0.0 {
         offset = -offset;
     }
+    let side = if w.dot(n) < 0.0 { -n } else { n };
     let mut po = p + offset;
-    // Round away from p so that rounding in the addition cannot pull the origin back.
+    // Round away from p so that rounding in the addition cannot pull the origin back; this
+    // also moves an origin whose error bound is exactly zero (a plane through 0) off the plane.
     for i in 0..3 {
-        if offset[i] > 0.0 {
+        if side[i] > 0.0 {
             po[i] = next_float_up(po[i]);
-        } else if offset[i] < 0.0 {
+        } else if side[i] < 0.0 {
             po[i] = next_float_down(po[i]);
         }
     }
     po
+}
+
+/// The extra error of a hit found in object space: the ray's origin was carried there with
+/// `object_from_world` (rounded), so the surface point is uncertain by that rounding, mapped
+/// back to world space. Without it, spawned rays far from the origin re-hit moving surfaces.
+pub(crate) fn object_space_error(world_from_object: &Mat4, object_from_world: &Mat4, p_world: Vec3) -> Vec3 {
+    let abs_inv = glam::Mat3::from_mat4(*object_from_world).abs();
+    let inv_translation = object_from_world.w_axis.truncate().abs();
+    let err_object = gamma(4) * (abs_inv * p_world.abs() + inv_translation);
+    let abs_linear = glam::Mat3::from_mat4(*world_from_object).abs();
+    (1.0 + gamma(3)) * (abs_linear * err_object)
 }
 
 /// The next representable f32 above `v` (identity for +inf and NaN).

@@ -3,7 +3,7 @@
 use crate::error::AccelError;
 use crate::geom::{
     QuadHit, TriangleHit, gamma, intersect_quad, intersect_sphere, intersect_triangle,
-    transform_point_with_error,
+    object_space_error, transform_point_with_error,
 };
 use crate::hit::Hit;
 use crate::mesh::TriangleMesh;
@@ -640,6 +640,12 @@ impl Scene {
                 let (p_object, err_object) = barycentric_point(&corners, tri);
                 let (p, p_error) =
                     transform_point_with_error(&world_from_object.matrix(), p_object, err_object);
+                let p_error = p_error
+                    + object_space_error(
+                        &world_from_object.matrix(),
+                        &world_from_object.inverse_matrix(),
+                        p,
+                    );
                 let n_object = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
                 let n_geo = normal_to_world(&world_from_object, n_object);
                 self.triangle_hit(
@@ -719,6 +725,12 @@ impl Scene {
     ) -> Hit {
         let (p, p_error) =
             transform_point_with_error(&world_from_object.matrix(), p_object, err_object);
+        let p_error = p_error
+            + object_space_error(
+                &world_from_object.matrix(),
+                &world_from_object.inverse_matrix(),
+                p,
+            );
         let n = Normal3::from_glam(normal_to_world(world_from_object, n_object));
         Hit {
             t,

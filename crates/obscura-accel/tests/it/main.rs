@@ -1,1 +1,8 @@
+//! Integration tests of obscura-accel: the BVH against a brute-force f64 reference, moving
+//! instances, OBJ files good and bad, and self-intersection of spawned rays.
 
+mod brute;
+mod exact;
+mod obj_files;
+mod reference;
+mod spawn;
