@@ -262,15 +262,20 @@ pub fn look_at_pose(
     }
 }
 
-/// Moves a camera-space ray to world space with `pose`, keeping the direction unit length:
-/// a pose with scale would stretch it, so the direction is renormalised and the `t` range
-/// rescaled to keep the same points.
+/// Moves a camera-space ray to world space with `pose`, keeping the direction unit length.
+/// A rigid pose (a look-at) changes lengths only by rounding: the direction is renormalised and
+/// `t` kept, so the clip range stays exactly `[near, far]`. A pose with scale would stretch the
+/// direction: then the `t` range is rescaled too, to keep the same points.
 #[inline]
 pub(crate) fn to_world(pose: &Transform<World, CameraSpace>, ray: Ray<CameraSpace>) -> Ray<World> {
     let ray = pose.ray(ray);
     let length = ray.direction.length();
+    let direction = ray.direction / length;
+    if (length - 1.0).abs() <= 1e-5 {
+        return Ray { direction, ..ray };
+    }
     Ray {
-        direction: ray.direction / length,
+        direction,
         t_min: ray.t_min * length,
         t_max: ray.t_max * length,
         ..ray

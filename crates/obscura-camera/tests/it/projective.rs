@@ -83,8 +83,8 @@ proptest! {
         prop_assert!((ray.direction.length() - 1.0).abs() < 1e-5);
         // A distance strictly inside the clip range (at its ends rounding may step outside),
         // and at least 1 so the eye's rounding stays small against it.
-        let upper = ray.t_max.min(100.0);
-        let lower = ray.t_min.max(1.0).min(upper);
+        let lower = ray.t_min.max(1.0);
+        let upper = ray.t_max.min(100.0 * lower);
         let d = lower + frac * (upper - lower);
         let back = camera.project(ray.at(d), ray.time).unwrap();
         // Rounding of the world point (eye up to ~17 from the origin) turned into pixels.
