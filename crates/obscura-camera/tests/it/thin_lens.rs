@@ -77,9 +77,13 @@ proptest! {
             AnyCamera::Orthographic(c) => c.projective().base(),
             AnyCamera::Environment(_) => unreachable!(),
         };
+        // (Within 0.1% of a clip plane rounding decides; those cases are not checked.)
         let inside = focus > base.near * 1.001 && focus < base.far * 0.999;
+        let outside = focus < base.near * 0.999 || focus > base.far * 1.001;
         let back = camera.project(p_world, 0.0);
-        prop_assert_eq!(back.is_some(), inside);
+        if inside || outside {
+            prop_assert_eq!(back.is_some(), inside);
+        }
         if let Some(back) = back {
             let [w, h] = camera.film().resolution().map(|r| r as f32);
             assert_close2(back.to_glam(), p_film.to_glam(), 1e-3 * w.max(h));
