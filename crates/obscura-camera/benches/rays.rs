@@ -1,6 +1,10 @@
 //! Camera rays generated per second for each model, with and without a lens, on one thread.
 //!
 //! Run with `cargo bench -p obscura-camera --bench rays`.
+#![allow(
+    missing_docs,
+    reason = "criterion_group! generates an undocumented public function"
+)]
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use obscura_camera::{

@@ -61,7 +61,14 @@ fn main() -> Result<(), CameraError> {
             let r = cr.ray;
             println!(
                 "  pixel ({i}, {j}): origin ({:+.4}, {:+.4}, {:+.4})  direction ({:+.4}, {:+.4}, {:+.4})  t in [{:.4}, {:.3e}]",
-                r.origin.x, r.origin.y, r.origin.z, r.direction.x, r.direction.y, r.direction.z, r.t_min, r.t_max
+                r.origin.x,
+                r.origin.y,
+                r.origin.z,
+                r.direction.x,
+                r.direction.y,
+                r.direction.z,
+                r.t_min,
+                r.t_max
             );
         }
     }

@@ -299,70 +299,6 @@ pub(crate) fn differential(
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn lens_validation() {
-        assert!(ThinLens::new(0.0, 1.0).is_ok());
-        assert!(matches!(
-            ThinLens::new(-0.1, 1.0),
-            Err(CameraError::LensRadius { .. })
-        ));
-        assert!(matches!(
-            ThinLens::new(0.1, 0.0),
-            Err(CameraError::FocalDistance { .. })
-        ));
-        assert!(matches!(
-            ThinLens::new(f32::NAN, 1.0),
-            Err(CameraError::NonFinite { .. })
-        ));
-        let lens = ThinLens::new(0.1, 2.0).unwrap();
-        assert!(lens.with_blades(2, 0.0).is_err());
-        assert!(lens.with_blades(6, 15.0).is_ok());
-    }
-
-    #[test]
-    fn aperture_points_stay_inside_the_radius() {
-        let lens = ThinLens::new(0.5, 1.0).unwrap();
-        let hex = lens.with_blades(6, 0.0).unwrap();
-        for i in 0..16 {
-            for j in 0..16 {
-                let u = glam::Vec2::new(i as f32 / 16.0, j as f32 / 16.0);
-                assert!(lens.aperture_point(u).length() <= 0.5 + 1e-6);
-                assert!(hex.aperture_point(u).length() <= 0.5 + 1e-6);
-            }
-        }
-        // The centre of the square is the centre of the lens.
-        assert_eq!(lens.aperture_point(glam::Vec2::splat(0.5)), glam::Vec2::ZERO);
-    }
-
-    #[test]
-    fn look_at_pose_is_fixed_without_end_or_with_instant_shutter() {
-        let start = (
-            Point3::new(0.0, 0.0, 0.0),
-            Point3::new(0.0, 0.0, -1.0),
-            Vector3::new(0.0, 1.0, 0.0),
-        );
-        let end = (
-            Point3::new(1.0, 0.0, 0.0),
-            Point3::new(1.0, 0.0, -1.0),
-            Vector3::new(0.0, 1.0, 0.0),
-        );
-        let shutter = Shutter::new(0.0, 1.0).unwrap();
-        assert!(!look_at_pose(start, None, shutter).unwrap().is_animated());
-        assert!(look_at_pose(start, Some(end), shutter).unwrap().is_animated());
-        let instant = Shutter::new(0.5, 0.5).unwrap();
-        assert!(!look_at_pose(start, Some(end), instant).unwrap().is_animated());
-        let bad = (start.0, start.0, start.2);
-        assert!(matches!(
-            look_at_pose(bad, None, shutter),
-            Err(CameraError::Pose(_))
-        ));
-    }
-}
-
 /// The camera-space ray of one film point, lens sample and time; the model's own part.
 pub(crate) trait CameraRayModel {
     fn base(&self) -> &CameraBase;
@@ -411,5 +347,84 @@ pub(crate) fn generate_differential<M: CameraRayModel>(
         ray_camera.time = time;
         to_world(&pose, ray_camera)
     };
-    Some(differential(world(0.0, 0.0), world(1.0, 0.0), world(0.0, 1.0)))
+    Some(differential(
+        world(0.0, 0.0),
+        world(1.0, 0.0),
+        world(0.0, 1.0),
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lens_validation() {
+        assert!(ThinLens::new(0.0, 1.0).is_ok());
+        assert!(matches!(
+            ThinLens::new(-0.1, 1.0),
+            Err(CameraError::LensRadius { .. })
+        ));
+        assert!(matches!(
+            ThinLens::new(0.1, 0.0),
+            Err(CameraError::FocalDistance { .. })
+        ));
+        assert!(matches!(
+            ThinLens::new(f32::NAN, 1.0),
+            Err(CameraError::NonFinite { .. })
+        ));
+        let lens = ThinLens::new(0.1, 2.0).unwrap();
+        assert!(lens.with_blades(2, 0.0).is_err());
+        assert!(lens.with_blades(6, 15.0).is_ok());
+    }
+
+    #[test]
+    fn aperture_points_stay_inside_the_radius() {
+        let lens = ThinLens::new(0.5, 1.0).unwrap();
+        let hex = lens.with_blades(6, 0.0).unwrap();
+        for i in 0..16 {
+            for j in 0..16 {
+                let u = glam::Vec2::new(i as f32 / 16.0, j as f32 / 16.0);
+                assert!(lens.aperture_point(u).length() <= 0.5 + 1e-6);
+                assert!(hex.aperture_point(u).length() <= 0.5 + 1e-6);
+            }
+        }
+        // The centre of the square is the centre of the lens.
+        assert_eq!(
+            lens.aperture_point(glam::Vec2::splat(0.5)),
+            glam::Vec2::ZERO
+        );
+    }
+
+    #[test]
+    fn look_at_pose_is_fixed_without_end_or_with_instant_shutter() {
+        let start = (
+            Point3::new(0.0, 0.0, 0.0),
+            Point3::new(0.0, 0.0, -1.0),
+            Vector3::new(0.0, 1.0, 0.0),
+        );
+        let end = (
+            Point3::new(1.0, 0.0, 0.0),
+            Point3::new(1.0, 0.0, -1.0),
+            Vector3::new(0.0, 1.0, 0.0),
+        );
+        let shutter = Shutter::new(0.0, 1.0).unwrap();
+        assert!(!look_at_pose(start, None, shutter).unwrap().is_animated());
+        assert!(
+            look_at_pose(start, Some(end), shutter)
+                .unwrap()
+                .is_animated()
+        );
+        let instant = Shutter::new(0.5, 0.5).unwrap();
+        assert!(
+            !look_at_pose(start, Some(end), instant)
+                .unwrap()
+                .is_animated()
+        );
+        let bad = (start.0, start.0, start.2);
+        assert!(matches!(
+            look_at_pose(bad, None, shutter),
+            Err(CameraError::Pose(_))
+        ));
+    }
 }

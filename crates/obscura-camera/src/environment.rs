@@ -61,7 +61,8 @@ impl CameraRayModel for EnvironmentCamera {
 
     #[inline]
     fn ray_camera(&self, p_film: Point2<Raster>, _u_lens: glam::Vec2) -> Ray<CameraSpace> {
-        Ray::new(Point3::ORIGIN, self.direction(p_film), 0.0).with_range(self.base.near, self.base.far)
+        Ray::new(Point3::ORIGIN, self.direction(p_film), 0.0)
+            .with_range(self.base.near, self.base.far)
     }
 }
 
@@ -88,10 +89,7 @@ impl Camera for EnvironmentCamera {
         let theta = d_camera.y.clamp(-1.0, 1.0).acos();
         let phi = d_camera.x.atan2(d_camera.z);
         let [width, height] = self.base.film.resolution().map(|r| r as f32);
-        Some(Point2::new(
-            width * (phi / TAU + 0.5),
-            height * theta / PI,
-        ))
+        Some(Point2::new(width * (phi / TAU + 0.5), height * theta / PI))
     }
     #[inline]
     fn film(&self) -> &FilmGeometry {

@@ -95,14 +95,23 @@ impl fmt::Display for CameraError {
                 f,
                 "fov_axis must be one of \"smaller\", \"larger\", \"x\", \"y\", \"diagonal\", got {name:?}"
             ),
-            CameraError::Near { got, positive: true } => {
+            CameraError::Near {
+                got,
+                positive: true,
+            } => {
                 write!(f, "near must be > 0 for a perspective camera, got {got}")
             }
-            CameraError::Near { got, positive: false } => {
+            CameraError::Near {
+                got,
+                positive: false,
+            } => {
                 write!(f, "near must be >= 0, got {got}")
             }
             CameraError::NearFar { near, far } => {
-                write!(f, "near must be less than far, got near = {near} and far = {far}")
+                write!(
+                    f,
+                    "near must be less than far, got near = {near} and far = {far}"
+                )
             }
             CameraError::LensRadius { got } => {
                 write!(f, "lens_radius must be >= 0, got {got}")
@@ -179,11 +188,19 @@ mod tests {
             "fov must be in (0, 180) degrees, got 180"
         );
         assert_eq!(
-            CameraError::NearFar { near: 2.0, far: 1.0 }.to_string(),
+            CameraError::NearFar {
+                near: 2.0,
+                far: 1.0
+            }
+            .to_string(),
             "near must be less than far, got near = 2 and far = 1"
         );
         assert_eq!(
-            CameraError::NonFinite { what: "near", got: f32::NAN }.to_string(),
+            CameraError::NonFinite {
+                what: "near",
+                got: f32::NAN
+            }
+            .to_string(),
             "near must be a finite number, got NaN"
         );
         assert!(

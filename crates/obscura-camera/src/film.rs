@@ -213,7 +213,8 @@ impl FilmGeometry {
         screen_window.validate()?;
         let crop_window = crop_window.unwrap_or([0.0, 1.0, 0.0, 1.0]);
         let [x0, x1, y0, y1] = crop_window;
-        let in_unit = |a: f32, b: f32| a.is_finite() && b.is_finite() && 0.0 <= a && a < b && b <= 1.0;
+        let in_unit =
+            |a: f32, b: f32| a.is_finite() && b.is_finite() && 0.0 <= a && a < b && b <= 1.0;
         if !(in_unit(x0, x1) && in_unit(y0, y1)) {
             return Err(CameraError::CropWindow { got: crop_window });
         }

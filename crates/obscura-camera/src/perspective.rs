@@ -7,9 +7,7 @@ use crate::camera::{
 use crate::error::{CameraError, finite};
 use crate::film::{FilmGeometry, FovAxis, Shutter};
 use crate::projective::{ProjectiveCamera, from_rows};
-use obscura_space::{
-    AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, Ray, World,
-};
+use obscura_space::{AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, Ray, World};
 
 /// A perspective camera: the projection plane at camera z = 1 scaled so that the field of view
 /// spans the screen window's half-extent along [`FovAxis`]; rays from the eye (or, with a thin

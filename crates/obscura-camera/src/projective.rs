@@ -3,10 +3,10 @@
 
 use crate::camera::{CameraBase, ThinLens};
 use crate::error::CameraError;
+use glam::{DMat4, DVec3};
 use obscura_space::{
     Camera as CameraSpace, Ndc, Point2, Point3, Raster, Ray, Screen, Transform, Vector3,
 };
-use glam::{DMat4, DVec3};
 
 /// The space chain of a projective camera, named the way the matrices compose:
 /// `camera_from_raster = camera_from_screen * screen_from_raster`, and so on.

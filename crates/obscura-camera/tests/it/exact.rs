@@ -15,11 +15,20 @@ fn world_dir(x: f32, y: f32, z: f32) -> glam::Vec3 {
 }
 
 fn perspective(res: [u32; 2], fov: f32, axis: FovAxis, lens: ThinLens) -> PerspectiveCamera {
-    PerspectiveCamera::new(base_at(identity_look(), res, None, 0.01, 100.0), fov, axis, lens).unwrap()
+    PerspectiveCamera::new(
+        base_at(identity_look(), res, None, 0.01, 100.0),
+        fov,
+        axis,
+        lens,
+    )
+    .unwrap()
 }
 
 fn ray_at(camera: &impl Camera, x: f32, y: f32) -> obscura_space::Ray<obscura_space::World> {
-    camera.generate_ray(&CameraSample::at(Point2::new(x, y))).unwrap().ray
+    camera
+        .generate_ray(&CameraSample::at(Point2::new(x, y)))
+        .unwrap()
+        .ray
 }
 
 #[test]
@@ -41,11 +50,27 @@ fn perspective_2x2_fov_90() {
     assert!((ray.t_min - 0.01 * 1.5f32.sqrt()).abs() < 1e-8);
     assert!((ray.t_max - 100.0 * 1.5f32.sqrt()).abs() < 1e-4);
     // Pixel (1, 0): screen (0.5, 0.5); pixel (1, 1): screen (0.5, -0.5).
-    assert_close3(ray_at(&camera, 1.5, 0.5).direction.to_glam(), world_dir(0.5, 0.5, 1.0), 1e-6);
-    assert_close3(ray_at(&camera, 1.5, 1.5).direction.to_glam(), world_dir(0.5, -0.5, 1.0), 1e-6);
+    assert_close3(
+        ray_at(&camera, 1.5, 0.5).direction.to_glam(),
+        world_dir(0.5, 0.5, 1.0),
+        1e-6,
+    );
+    assert_close3(
+        ray_at(&camera, 1.5, 1.5).direction.to_glam(),
+        world_dir(0.5, -0.5, 1.0),
+        1e-6,
+    );
     // The image centre (1, 1) looks straight ahead; the corner (0, 0) at 45 degrees both ways.
-    assert_close3(ray_at(&camera, 1.0, 1.0).direction.to_glam(), world_dir(0.0, 0.0, 1.0), 1e-7);
-    assert_close3(ray_at(&camera, 0.0, 0.0).direction.to_glam(), world_dir(-1.0, 1.0, 1.0), 1e-6);
+    assert_close3(
+        ray_at(&camera, 1.0, 1.0).direction.to_glam(),
+        world_dir(0.0, 0.0, 1.0),
+        1e-7,
+    );
+    assert_close3(
+        ray_at(&camera, 0.0, 0.0).direction.to_glam(),
+        world_dir(-1.0, 1.0, 1.0),
+        1e-6,
+    );
     // And projection: world (1, 2, -4) is camera (1, 2, 4), screen (0.25, 0.5),
     // NDC ((0.25 + 1) / 2, (1 - 0.5) / 2) = (0.625, 0.25), raster (1.25, 0.5).
     let p = camera.project(Point3::new(1.0, 2.0, -4.0), 0.0).unwrap();
@@ -58,22 +83,41 @@ fn perspective_4x2_fov_axes() {
     // screen (-2 + 0.875 * 4, 1 - 0.75 * 2) = (1.5, -0.5).
     // fov 90 along the smaller (y) half-extent 1: s = 1 / tan 45 = 1 -> direction (1.5, -0.5, 1).
     let c = perspective([4, 2], 90.0, FovAxis::Smaller, ThinLens::PINHOLE);
-    assert_close3(ray_at(&c, 3.5, 1.5).direction.to_glam(), world_dir(1.5, -0.5, 1.0), 1e-6);
+    assert_close3(
+        ray_at(&c, 3.5, 1.5).direction.to_glam(),
+        world_dir(1.5, -0.5, 1.0),
+        1e-6,
+    );
     // Along x (half-extent 2): s = 2 -> camera (1.5 / 2, -0.5 / 2, 1) = (0.75, -0.25, 1).
     let c = perspective([4, 2], 90.0, FovAxis::X, ThinLens::PINHOLE);
-    assert_close3(ray_at(&c, 3.5, 1.5).direction.to_glam(), world_dir(0.75, -0.25, 1.0), 1e-6);
+    assert_close3(
+        ray_at(&c, 3.5, 1.5).direction.to_glam(),
+        world_dir(0.75, -0.25, 1.0),
+        1e-6,
+    );
     let c = perspective([4, 2], 90.0, FovAxis::Larger, ThinLens::PINHOLE);
-    assert_close3(ray_at(&c, 3.5, 1.5).direction.to_glam(), world_dir(0.75, -0.25, 1.0), 1e-6);
+    assert_close3(
+        ray_at(&c, 3.5, 1.5).direction.to_glam(),
+        world_dir(0.75, -0.25, 1.0),
+        1e-6,
+    );
     // Along the diagonal (half-diagonal sqrt(5)): s = sqrt 5; the corner (4, 0) at screen
     // (2, 1) looks at (2, 1, 1) / sqrt 5 * ... = (2 / sqrt 5, 1 / sqrt 5, 1): 45 degrees off axis.
     let c = perspective([4, 2], 90.0, FovAxis::Diagonal, ThinLens::PINHOLE);
     let d = ray_at(&c, 4.0, 0.0).direction.to_glam();
-    assert!((d.dot(-glam::Vec3::Z) - 0.5f32.sqrt()).abs() < 1e-6, "{d:?}");
+    assert!(
+        (d.dot(-glam::Vec3::Z) - 0.5f32.sqrt()).abs() < 1e-6,
+        "{d:?}"
+    );
     // fov 60 along y on 2 x 2: s = 1 / tan 30 = sqrt 3; pixel (0, 0) at screen (-0.5, 0.5)
     // looks at (-0.5 / sqrt 3, 0.5 / sqrt 3, 1).
     let c = perspective([2, 2], 60.0, FovAxis::Y, ThinLens::PINHOLE);
     let r3 = 3f32.sqrt();
-    assert_close3(ray_at(&c, 0.5, 0.5).direction.to_glam(), world_dir(-0.5 / r3, 0.5 / r3, 1.0), 1e-6);
+    assert_close3(
+        ray_at(&c, 0.5, 0.5).direction.to_glam(),
+        world_dir(-0.5 / r3, 0.5 / r3, 1.0),
+        1e-6,
+    );
 }
 
 #[test]
@@ -82,8 +126,17 @@ fn perspective_thin_lens_pixel() {
     // (2 * 0.75 - 1, 2 * 0.5 - 1) = (0.5, 0): r = 0.5, angle 0 -> lens point (0.5, 0, 0).
     // Pixel (0, 0): pinhole direction (-0.5, 0.5, 1) reaches z = 2 at (-1, 1, 2).
     // Ray: from (0.5, 0, 0) towards (-1, 1, 2): direction (-1.5, 1, 2) / sqrt(7.25).
-    let camera = perspective([2, 2], 90.0, FovAxis::Smaller, ThinLens::new(1.0, 2.0).unwrap());
-    let sample = CameraSample { p_film: Point2::new(0.5, 0.5), p_lens: glam::Vec2::new(0.75, 0.5), time: 0.0 };
+    let camera = perspective(
+        [2, 2],
+        90.0,
+        FovAxis::Smaller,
+        ThinLens::new(1.0, 2.0).unwrap(),
+    );
+    let sample = CameraSample {
+        p_film: Point2::new(0.5, 0.5),
+        p_lens: glam::Vec2::new(0.75, 0.5),
+        time: 0.0,
+    };
     let ray = camera.generate_ray(&sample).unwrap().ray;
     assert_close3(ray.origin.to_glam(), glam::Vec3::new(0.5, 0.0, 0.0), 1e-7);
     assert_close3(ray.direction.to_glam(), world_dir(-1.5, 1.0, 2.0), 1e-6);
@@ -94,7 +147,13 @@ fn perspective_thin_lens_pixel() {
 #[test]
 fn orthographic_pixels() {
     // 4 x 2 with window [-2, 2] x [-1, 1] world units, near 0, far 10.
-    let base = base_at(identity_look(), [4, 2], Some(ScreenWindow::new(-2.0, 2.0, -1.0, 1.0).unwrap()), 0.0, 10.0);
+    let base = base_at(
+        identity_look(),
+        [4, 2],
+        Some(ScreenWindow::new(-2.0, 2.0, -1.0, 1.0).unwrap()),
+        0.0,
+        10.0,
+    );
     let camera = OrthographicCamera::new(base.clone(), ThinLens::PINHOLE).unwrap();
     // Pixel (0, 0): centre (0.5, 0.5) -> NDC (0.125, 0.25) -> (-2 + 0.125 * 4, 1 - 0.25 * 2)
     // = (-1.5, 0.5): the ray starts at camera (-1.5, 0.5, 0) along +z (world -z), t in [0, 10].
@@ -103,7 +162,11 @@ fn orthographic_pixels() {
     assert_close3(ray.direction.to_glam(), -glam::Vec3::Z, 0.0);
     assert_eq!((ray.t_min, ray.t_max), (0.0, 10.0));
     // Pixel (3, 1): centre (3.5, 1.5) -> NDC (0.875, 0.75) -> (1.5, -0.5).
-    assert_close3(ray_at(&camera, 3.5, 1.5).origin.to_glam(), glam::Vec3::new(1.5, -0.5, 0.0), 1e-7);
+    assert_close3(
+        ray_at(&camera, 3.5, 1.5).origin.to_glam(),
+        glam::Vec3::new(1.5, -0.5, 0.0),
+        1e-7,
+    );
     // Projection ignores depth: world (1, 0.25, -7) is camera (1, 0.25, 7) -> NDC
     // ((1 + 2) / 4, (1 - 0.25) / 2) = (0.75, 0.375) -> raster (3, 0.75).
     let p = camera.project(Point3::new(1.0, 0.25, -7.0), 0.0).unwrap();
@@ -113,7 +176,11 @@ fn orthographic_pixels() {
     // Pixel (0, 0): origin (-1.5 + 0.5, 0.5, 0) = (-1, 0.5, 0), towards the focus point
     // (-1.5, 0.5, 2): direction (-0.5, 0, 2) / sqrt(4.25).
     let camera = OrthographicCamera::new(base, ThinLens::new(1.0, 2.0).unwrap()).unwrap();
-    let sample = CameraSample { p_film: Point2::new(0.5, 0.5), p_lens: glam::Vec2::new(0.75, 0.5), time: 0.0 };
+    let sample = CameraSample {
+        p_film: Point2::new(0.5, 0.5),
+        p_lens: glam::Vec2::new(0.75, 0.5),
+        time: 0.0,
+    };
     let ray = camera.generate_ray(&sample).unwrap().ray;
     assert_close3(ray.origin.to_glam(), glam::Vec3::new(-1.0, 0.5, 0.0), 1e-7);
     assert_close3(ray.direction.to_glam(), world_dir(-0.5, 0.0, 2.0), 1e-6);
@@ -121,17 +188,30 @@ fn orthographic_pixels() {
 
 #[test]
 fn environment_pixels() {
-    let camera = EnvironmentCamera::new(base_at(identity_look(), [4, 2], None, 0.0, 1.0e30)).unwrap();
+    let camera =
+        EnvironmentCamera::new(base_at(identity_look(), [4, 2], None, 0.0, 1.0e30)).unwrap();
     let h = 0.5f32.sqrt();
     // Pixel (2, 1): centre (2.5, 1.5): theta = pi * 1.5 / 2 = 3 pi / 4,
     // phi = 2 pi (2.5 / 4 - 0.5) = pi / 4: d = (sin 3pi/4 sin pi/4, cos 3pi/4, sin 3pi/4 cos pi/4)
     // = (0.5, -0.7071, 0.5) in camera space.
-    assert_close3(ray_at(&camera, 2.5, 1.5).direction.to_glam(), world_dir(0.5, -h, 0.5), 1e-6);
+    assert_close3(
+        ray_at(&camera, 2.5, 1.5).direction.to_glam(),
+        world_dir(0.5, -h, 0.5),
+        1e-6,
+    );
     // Pixel (0, 0): centre (0.5, 0.5): theta = pi / 4, phi = 2 pi (0.125 - 0.5) = -3 pi / 4:
     // d = (0.7071 * -0.7071, 0.7071, 0.7071 * -0.7071) = (-0.5, 0.7071, -0.5): up, left, behind.
-    assert_close3(ray_at(&camera, 0.5, 0.5).direction.to_glam(), world_dir(-0.5, h, -0.5), 1e-6);
+    assert_close3(
+        ray_at(&camera, 0.5, 0.5).direction.to_glam(),
+        world_dir(-0.5, h, -0.5),
+        1e-6,
+    );
     // Raster (3, 1): theta = pi / 2, phi = 2 pi (0.75 - 0.5) = pi / 2: straight right (+x).
-    assert_close3(ray_at(&camera, 3.0, 1.0).direction.to_glam(), world_dir(1.0, 0.0, 0.0), 1e-6);
+    assert_close3(
+        ray_at(&camera, 3.0, 1.0).direction.to_glam(),
+        world_dir(1.0, 0.0, 0.0),
+        1e-6,
+    );
     // Inverse: world (0, 0, 3) (behind the eye: camera (0, 0, -3)) has theta = pi / 2,
     // phi = atan2(0, -3) = pi -> raster (4 * (1/2 + 1/2), 2 * 1/2) = (4, 1), the seam.
     let p = camera.project(Point3::new(0.0, 0.0, 3.0), 0.0).unwrap();

@@ -68,12 +68,16 @@ pub fn base_at(
 /// A random look-at: eye within 10 of the origin, target at unit-ish distance, up not parallel.
 pub fn look_strategy() -> impl Strategy<Value = (Point3<World>, Point3<World>, Vector3<World>)> {
     let v = || (-1f32..1.0, -1f32..1.0, -1f32..1.0);
-    ((-10f32..10.0, -10f32..10.0, -10f32..10.0), v(), v())
-        .prop_filter_map("degenerate look-at", |(e, d, u)| {
+    ((-10f32..10.0, -10f32..10.0, -10f32..10.0), v(), v()).prop_filter_map(
+        "degenerate look-at",
+        |(e, d, u)| {
             let eye = glam::Vec3::new(e.0, e.1, e.2);
             let dir = glam::Vec3::new(d.0, d.1, d.2);
             let up = glam::Vec3::new(u.0, u.1, u.2);
-            if dir.length() < 0.3 || up.length() < 0.3 || dir.normalize().cross(up.normalize()).length() < 0.2 {
+            if dir.length() < 0.3
+                || up.length() < 0.3
+                || dir.normalize().cross(up.normalize()).length() < 0.2
+            {
                 return None;
             }
             Some((
@@ -81,7 +85,8 @@ pub fn look_strategy() -> impl Strategy<Value = (Point3<World>, Point3<World>, V
                 Point3::from_glam(eye + dir),
                 Vector3::from_glam(up),
             ))
-        })
+        },
+    )
 }
 
 /// A random resolution between 1 and 2000 per axis.
@@ -97,35 +102,57 @@ pub fn projective_strategy(with_lens: bool) -> impl Strategy<Value = AnyCamera> 
         resolution_strategy(),
         1f32..170.0,
         0usize..5,
-        prop_oneof![Just((0.001f32, 1.0e30f32)), Just((0.1, 1000.0)), (0.01f32..1.0, 2f32..100.0)],
+        prop_oneof![
+            Just((0.001f32, 1.0e30f32)),
+            Just((0.1, 1000.0)),
+            (0.01f32..1.0, 2f32..100.0)
+        ],
         (0.01f32..0.5, 0.5f32..20.0),
         any::<bool>(),
     )
-        .prop_map(move |(look, res, fov, axis, (near, far), (radius, focus), ortho)| {
-            let lens = if with_lens {
-                ThinLens::new(radius, focus).unwrap()
-            } else {
-                ThinLens::PINHOLE
-            };
-            let base = base_at(look, res, None, near, far);
-            if ortho {
-                OrthographicCamera::new(base, lens).unwrap().into()
-            } else {
-                let axis = [FovAxis::Smaller, FovAxis::Larger, FovAxis::X, FovAxis::Y, FovAxis::Diagonal][axis];
-                PerspectiveCamera::new(base, fov, axis, lens).unwrap().into()
-            }
-        })
+        .prop_map(
+            move |(look, res, fov, axis, (near, far), (radius, focus), ortho)| {
+                let lens = if with_lens {
+                    ThinLens::new(radius, focus).unwrap()
+                } else {
+                    ThinLens::PINHOLE
+                };
+                let base = base_at(look, res, None, near, far);
+                if ortho {
+                    OrthographicCamera::new(base, lens).unwrap().into()
+                } else {
+                    let axis = [
+                        FovAxis::Smaller,
+                        FovAxis::Larger,
+                        FovAxis::X,
+                        FovAxis::Y,
+                        FovAxis::Diagonal,
+                    ][axis];
+                    PerspectiveCamera::new(base, fov, axis, lens)
+                        .unwrap()
+                        .into()
+                }
+            },
+        )
 }
 
 /// A random environment camera.
 pub fn environment_strategy() -> impl Strategy<Value = EnvironmentCamera> {
-    (look_strategy(), resolution_strategy(), prop_oneof![Just(0.0f32), 0.001f32..0.5])
+    (
+        look_strategy(),
+        resolution_strategy(),
+        prop_oneof![Just(0.0f32), 0.001f32..0.5],
+    )
         .prop_map(|(look, res, near)| {
             EnvironmentCamera::new(base_at(look, res, None, near, 1.0e30)).unwrap()
         })
 }
 
 /// A raster position anywhere on the film of `resolution` (fractions in [0, 1)).
-pub fn raster_in(resolution: [u32; 2], fx: f32, fy: f32) -> obscura_space::Point2<obscura_space::Raster> {
+pub fn raster_in(
+    resolution: [u32; 2],
+    fx: f32,
+    fy: f32,
+) -> obscura_space::Point2<obscura_space::Raster> {
     obscura_space::Point2::new(fx * resolution[0] as f32, fy * resolution[1] as f32)
 }

@@ -13,7 +13,9 @@ use proptest::prelude::*;
 fn models(base: CameraBase) -> Vec<AnyCamera> {
     let lens = ThinLens::new(0.1, 3.0).unwrap();
     vec![
-        PerspectiveCamera::new(base.clone(), 60.0, FovAxis::Smaller, lens).unwrap().into(),
+        PerspectiveCamera::new(base.clone(), 60.0, FovAxis::Smaller, lens)
+            .unwrap()
+            .into(),
         OrthographicCamera::new(base.clone(), lens).unwrap().into(),
         EnvironmentCamera::new(base).unwrap().into(),
     ]
@@ -72,8 +74,16 @@ fn halfway_through_the_shutter() {
         FilmGeometry::new([8, 8], None, None).unwrap(),
     );
     let camera = PerspectiveCamera::new(base, 90.0, FovAxis::Smaller, ThinLens::PINHOLE).unwrap();
-    for (u, time, eye_x) in [(0.0, 2.0, 0.0), (0.25, 2.5, 0.5), (0.5, 3.0, 1.0), (0.75, 3.5, 1.5)] {
-        let sample = CameraSample { time: u, ..CameraSample::at(Point2::new(4.0, 4.0)) };
+    for (u, time, eye_x) in [
+        (0.0, 2.0, 0.0),
+        (0.25, 2.5, 0.5),
+        (0.5, 3.0, 1.0),
+        (0.75, 3.5, 1.5),
+    ] {
+        let sample = CameraSample {
+            time: u,
+            ..CameraSample::at(Point2::new(4.0, 4.0))
+        };
         let ray = camera.generate_ray(&sample).unwrap().ray;
         assert_eq!(ray.time, time);
         assert_close3(ray.origin.to_glam(), glam::Vec3::new(eye_x, 0.0, 0.0), 1e-5);

@@ -1,9 +1,7 @@
 //! The projective chain and the pinhole models: round trips, projection of generated rays,
 //! parallel and converging rays, clipping at the boundaries, precision with extreme clip planes.
 
-use crate::{
-    assert_close2, assert_close3, base_at, identity_look, projective_strategy, raster_in,
-};
+use crate::{assert_close2, assert_close3, base_at, identity_look, projective_strategy, raster_in};
 use obscura_camera::{
     AnyCamera, Camera, CameraSample, FovAxis, OrthographicCamera, PerspectiveCamera,
     ProjectiveCamera, ThinLens,
@@ -30,7 +28,11 @@ fn raster_per_unit(camera: &AnyCamera, ray: &obscura_space::Ray<obscura_space::W
     match camera {
         AnyCamera::Perspective(c) => {
             let s = c.projective().screen_from_camera().matrix().x_axis.x;
-            let d = camera.world_from_camera().at(0.0).inverse().vector(ray.direction);
+            let d = camera
+                .world_from_camera()
+                .at(0.0)
+                .inverse()
+                .vector(ray.direction);
             let tan2 = (d.x * d.x + d.y * d.y) / (d.z * d.z);
             per_screen * s * (1.0 + tan2)
         }
@@ -152,10 +154,12 @@ fn project_respects_near_and_far() {
         )
         .unwrap()
         .into();
-        let ortho: AnyCamera =
-            OrthographicCamera::new(base_at(identity_look(), [8, 6], None, near, far), ThinLens::PINHOLE)
-                .unwrap()
-                .into();
+        let ortho: AnyCamera = OrthographicCamera::new(
+            base_at(identity_look(), [8, 6], None, near, far),
+            ThinLens::PINHOLE,
+        )
+        .unwrap()
+        .into();
         for camera in [perspective, ortho] {
             let at = |z: f32| camera.project(Point3::new(0.01 * z, 0.0, -z), 0.0);
             assert!(at(near).is_some(), "near {near} itself is visible");
@@ -183,22 +187,31 @@ fn extreme_clip_planes_keep_precision() {
         )
         .unwrap();
         let chain = camera.projective();
-        let s_near = chain.screen_from_camera().point(Point3::new(0.0, 0.0, near));
+        let s_near = chain
+            .screen_from_camera()
+            .point(Point3::new(0.0, 0.0, near));
         let s_far = chain.screen_from_camera().point(Point3::new(0.0, 0.0, far));
         assert!(s_near.z.abs() < 1e-6, "screen z at near: {}", s_near.z);
         assert!((s_far.z - 1.0).abs() < 1e-5, "screen z at far: {}", s_far.z);
         // The inverse matrix really is the inverse (no numerical inversion of a 1e30 entry).
-        let back = chain.camera_from_screen().point(Point3::new(0.3, -0.2, 0.0));
+        let back = chain
+            .camera_from_screen()
+            .point(Point3::new(0.3, -0.2, 0.0));
         assert!((back.z - near).abs() < 1e-6 * near.max(1.0));
         let mut worst = 0f32;
         for j in (0..1080).step_by(7) {
             for i in (0..1920).step_by(11) {
                 let p = Point3::<Raster>::new(i as f32 + 0.5, j as f32 + 0.5, 0.0);
-                let q = chain.raster_from_camera().point(chain.camera_from_raster().point(p));
+                let q = chain
+                    .raster_from_camera()
+                    .point(chain.camera_from_raster().point(p));
                 worst = worst.max((q.to_glam() - p.to_glam()).abs().max_element());
             }
         }
-        assert!(worst < 1e-3, "near {near}, far {far}: worst round trip error {worst} px");
+        assert!(
+            worst < 1e-3,
+            "near {near}, far {far}: worst round trip error {worst} px"
+        );
         // And through the full ray: the image corner's ray projects back.
         let corner = Point2::new(0.5, 0.5);
         let ray = camera.generate_ray(&CameraSample::at(corner)).unwrap().ray;
@@ -227,8 +240,14 @@ fn differentials_are_neighbouring_rays() {
         let diff = camera.generate_ray_differential(&sample).unwrap();
         let main = camera.generate_ray(&sample).unwrap().ray;
         assert_eq!(diff.ray, main);
-        let right = CameraSample { p_film: Point2::new(4.25, 4.75), ..sample };
-        let down = CameraSample { p_film: Point2::new(3.25, 5.75), ..sample };
+        let right = CameraSample {
+            p_film: Point2::new(4.25, 4.75),
+            ..sample
+        };
+        let down = CameraSample {
+            p_film: Point2::new(3.25, 5.75),
+            ..sample
+        };
         let rx = camera.generate_ray(&right).unwrap().ray;
         let ry = camera.generate_ray(&down).unwrap().ray;
         assert_close3(diff.rx_origin.to_glam(), rx.origin.to_glam(), 1e-6);

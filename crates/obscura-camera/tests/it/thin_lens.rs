@@ -134,6 +134,10 @@ fn orthographic_lens_is_centred_on_the_film_point() {
         assert!(offset.length() <= 0.1 + 1e-6, "origin {:?}", ray.origin);
         // And it reaches the film point's ray at z = 4 (world z = -4).
         let p = ray.at(4.0 / -ray.direction.z);
-        assert_close3(p.to_glam(), Point3::<obscura_space::World>::new(0.9, 0.9, -4.0).to_glam(), 1e-5);
+        assert_close3(
+            p.to_glam(),
+            Point3::<obscura_space::World>::new(0.9, 0.9, -4.0).to_glam(),
+            1e-5,
+        );
     }
 }
