@@ -148,7 +148,8 @@ pub fn power_heuristic(pdf_a: f32, pdf_b: f32) -> f32 {
         return 1.0;
     }
     let (a, b) = (pdf_a * pdf_a, pdf_b * pdf_b);
-    if !(a + b > 0.0) || !(a + b).is_finite() {
+    let sum = a + b;
+    if sum <= 0.0 || !sum.is_finite() {
         // Both zero (no strategy) or overflow: fall back to comparing the densities directly.
         return if pdf_a >= pdf_b && pdf_a > 0.0 {
             1.0
@@ -156,7 +157,7 @@ pub fn power_heuristic(pdf_a: f32, pdf_b: f32) -> f32 {
             0.0
         };
     }
-    a / (a + b)
+    a / sum
 }
 
 /// Unidirectional path tracing with next-event estimation and MIS (power heuristic).

@@ -177,7 +177,8 @@ pub struct AreaLight {
     instance: u32,
     emission: Vec3,
     shape: EmitterShape,
-    pose: Pose,
+    /// Boxed: transforms are large, and [`Light`]'s variants should stay close in size.
+    pose: Box<Pose>,
 }
 
 /// A point sampled on an emitter's surface, with its unit outward normal and area density.
@@ -238,10 +239,10 @@ impl AreaLight {
                 }
             }
         };
-        let pose = match placement {
+        let pose = Box::new(match placement {
             Placement::Static(t) => Pose::Static(*t),
             Placement::Moving(a) => Pose::Moving(a.clone()),
-        };
+        });
         Ok(AreaLight {
             instance,
             emission,
@@ -348,7 +349,6 @@ impl AreaLight {
         let one_minus_cos_max = sin2_max / (1.0 + cos_max);
         let sin2_theta = u2.x * one_minus_cos_max * (2.0 - u2.x * one_minus_cos_max);
         let cos_theta = (1.0 - sin2_theta).max(0.0).sqrt();
-        let sin_theta = sin2_theta.max(0.0).sqrt();
         // The point on the sphere seen at that angle: the nearer intersection of the ray.
         let ds = dc * cos_theta - (r2 - dc2 * sin2_theta).max(0.0).sqrt();
         let cos_alpha = ((dc2 + r2 - ds * ds) / (2.0 * dc * r)).clamp(-1.0, 1.0);
@@ -362,7 +362,6 @@ impl AreaLight {
         ));
         let p_light = c + r * n_light;
         let wi = (p_light - p_ref).try_normalize()?;
-        let _ = sin_theta;
         let pdf = cone_pdf(sin2_max);
         if !pdf.is_finite() {
             return None;
@@ -672,8 +671,11 @@ impl EnvironmentLight {
         match &self.kind {
             EnvironmentKind::Constant(_) => uniform_sphere_pdf(),
             EnvironmentKind::Map(map) => {
-                let uv = direction_to_uv(map.light_from_world * d_world);
-                let sin_theta = (PI * uv.y).sin();
+                let d_light = map.light_from_world * d_world;
+                let uv = direction_to_uv(d_light);
+                // sin(theta) from the direction itself: well conditioned at the poles, where
+                // going through acos would lose most digits.
+                let sin_theta = Vec2::new(d_light.x, d_light.z).length() / d_light.length();
                 if sin_theta <= TINY {
                     return 0.0;
                 }
@@ -697,7 +699,8 @@ impl EnvironmentMap {
 /// `phi = atan2(x, z)` from +z towards +x, `v = theta / pi` with `theta` from +y (the
 /// environment camera's mapping).
 pub fn direction_to_uv(d_light: Vec3) -> Vec2 {
-    let theta = d_light.y.clamp(-1.0, 1.0).acos();
+    // atan2 rather than acos(y): accurate near the poles too.
+    let theta = Vec2::new(d_light.x, d_light.z).length().atan2(d_light.y);
     let phi = d_light.x.atan2(d_light.z);
     let u = (phi / TAU + 0.5).clamp(0.0, 1.0);
     let v = (theta / PI).clamp(0.0, 1.0);

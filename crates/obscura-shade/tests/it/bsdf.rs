@@ -230,8 +230,8 @@ fn histogram_check(m: &Material, wo: Vec3, seed: u64) {
         let ip = ((p / TAU * NP as f32) as usize).min(NP - 1);
         observed[iz][ip] += 1;
     }
-    for iz in 0..NZ {
-        for ip in 0..NP {
+    for (iz, row) in observed.iter().enumerate() {
+        for (ip, &count) in row.iter().enumerate() {
             // Cells are equal-area in (z, phi): solid angle = dz dphi.
             let mut integral = 0.0;
             for a in 0..6 {
@@ -244,7 +244,7 @@ fn histogram_check(m: &Material, wo: Vec3, seed: u64) {
                 }
             }
             let expected = integral as f64 * N as f64;
-            let obs = observed[iz][ip] as f64;
+            let obs = count as f64;
             // Poisson noise (5 sigma) plus 5% for the quadrature of a peaked pdf.
             let tolerance = 5.0 * expected.sqrt() + 0.05 * expected + 5.0;
             assert!(
