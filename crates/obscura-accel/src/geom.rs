@@ -83,11 +83,7 @@ pub(crate) fn intersect_sphere(
     let root = (a * disc).sqrt();
     // q = -(b + sign(b) sqrt(disc)) avoids cancellation; the roots are q / a and c / q.
     let q = -(b_half + root.copysign(b_half));
-    let (mut t0, mut t1) = if q == 0.0 {
-        (0.0, 0.0)
-    } else {
-        (q / a, c / q)
-    };
+    let (mut t0, mut t1) = if q == 0.0 { (0.0, 0.0) } else { (q / a, c / q) };
     if t0 > t1 {
         core::mem::swap(&mut t0, &mut t1);
     }
@@ -178,7 +174,11 @@ pub(crate) fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec
 /// The extra error of a hit found in object space: the ray's origin was carried there with
 /// `object_from_world` (rounded), so the surface point is uncertain by that rounding, mapped
 /// back to world space. Without it, spawned rays far from the origin re-hit moving surfaces.
-pub(crate) fn object_space_error(world_from_object: &Mat4, object_from_world: &Mat4, p_world: Vec3) -> Vec3 {
+pub(crate) fn object_space_error(
+    world_from_object: &Mat4,
+    object_from_world: &Mat4,
+    p_world: Vec3,
+) -> Vec3 {
     let abs_inv = glam::Mat3::from_mat4(*object_from_world).abs();
     let inv_translation = object_from_world.w_axis.truncate().abs();
     let err_object = gamma(4) * (abs_inv * p_world.abs() + inv_translation);
@@ -211,15 +211,31 @@ mod tests {
     fn triangle_hit_exact() {
         // The triangle (0,0,0), (1,0,0), (0,1,0) in the plane z = 0; a ray from (0.25, 0.5, 2)
         // straight down (d = (0, 0, -1)) meets it at t = 2 with b1 = x = 0.25, b2 = y = 0.5.
-        let tri = [vec3a(0.0, 0.0, 0.0), vec3a(1.0, 0.0, 0.0), vec3a(0.0, 1.0, 0.0)];
-        let hit =
-            intersect_triangle(vec3a(0.25, 0.5, 2.0), vec3a(0.0, 0.0, -1.0), 0.0, 10.0, &tri)
-                .unwrap();
+        let tri = [
+            vec3a(0.0, 0.0, 0.0),
+            vec3a(1.0, 0.0, 0.0),
+            vec3a(0.0, 1.0, 0.0),
+        ];
+        let hit = intersect_triangle(
+            vec3a(0.25, 0.5, 2.0),
+            vec3a(0.0, 0.0, -1.0),
+            0.0,
+            10.0,
+            &tri,
+        )
+        .unwrap();
         assert_eq!((hit.t, hit.b1, hit.b2), (2.0, 0.25, 0.5));
         // Outside (x + y = 1.5 > 1) and beyond t_max both miss.
-        let miss = intersect_triangle(vec3a(0.75, 0.75, 2.0), vec3a(0.0, 0.0, -1.0), 0.0, 10.0, &tri);
+        let miss = intersect_triangle(
+            vec3a(0.75, 0.75, 2.0),
+            vec3a(0.0, 0.0, -1.0),
+            0.0,
+            10.0,
+            &tri,
+        );
         assert!(miss.is_none());
-        let short = intersect_triangle(vec3a(0.25, 0.5, 2.0), vec3a(0.0, 0.0, -1.0), 0.0, 1.5, &tri);
+        let short =
+            intersect_triangle(vec3a(0.25, 0.5, 2.0), vec3a(0.0, 0.0, -1.0), 0.0, 1.5, &tri);
         assert!(short.is_none());
     }
 
@@ -229,14 +245,26 @@ mod tests {
         let c = Vec3::new(0.0, 0.0, -5.0);
         let o = Vec3::ZERO;
         let d = Vec3::new(0.0, 0.0, -1.0);
-        assert_eq!(intersect_sphere(o, d, 0.0, f32::INFINITY, c, 1.0), Some(4.0));
+        assert_eq!(
+            intersect_sphere(o, d, 0.0, f32::INFINITY, c, 1.0),
+            Some(4.0)
+        );
         // With t_min past the near root the far root is the answer.
-        assert_eq!(intersect_sphere(o, d, 4.5, f32::INFINITY, c, 1.0), Some(6.0));
+        assert_eq!(
+            intersect_sphere(o, d, 4.5, f32::INFINITY, c, 1.0),
+            Some(6.0)
+        );
         // A direction of length 2 halves t.
-        assert_eq!(intersect_sphere(o, d * 2.0, 0.0, f32::INFINITY, c, 1.0), Some(2.0));
+        assert_eq!(
+            intersect_sphere(o, d * 2.0, 0.0, f32::INFINITY, c, 1.0),
+            Some(2.0)
+        );
         // Offset by 1.5 sideways the line passes at distance 1.5 > 1: miss.
         let o_side = Vec3::new(1.5, 0.0, 0.0);
-        assert_eq!(intersect_sphere(o_side, d, 0.0, f32::INFINITY, c, 1.0), None);
+        assert_eq!(
+            intersect_sphere(o_side, d, 0.0, f32::INFINITY, c, 1.0),
+            None
+        );
     }
 
     #[test]

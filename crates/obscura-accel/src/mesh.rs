@@ -164,8 +164,13 @@ mod tests {
         // (x = 2 on the x axis): both have zero area.
         let mut p = quad_positions();
         p.push(Vec3::new(2.0, 0.0, 0.0));
-        let mesh = TriangleMesh::new(p, vec![[0, 1, 2], [0, 1, 1], [0, 2, 3], [0, 1, 4]], None, None)
-            .unwrap();
+        let mesh = TriangleMesh::new(
+            p,
+            vec![[0, 1, 2], [0, 1, 1], [0, 2, 3], [0, 1, 4]],
+            None,
+            None,
+        )
+        .unwrap();
         assert_eq!(mesh.triangle_count(), 2);
         assert_eq!(mesh.skipped_degenerate(), 2);
         assert_eq!(mesh.triangles(), &[[0, 1, 2], [0, 2, 3]]);
@@ -183,10 +188,20 @@ mod tests {
         assert!(nan.unwrap_err().to_string().contains("NaN"));
         let short_normals =
             TriangleMesh::new(quad_positions(), vec![[0, 1, 2]], Some(vec![Vec3::Z]), None);
-        assert!(short_normals.unwrap_err().to_string().contains("1 normals for 4"));
+        assert!(
+            short_normals
+                .unwrap_err()
+                .to_string()
+                .contains("1 normals for 4")
+        );
         let empty = TriangleMesh::new(quad_positions(), vec![], None, None);
         assert!(empty.is_err());
         let all_degenerate = TriangleMesh::new(quad_positions(), vec![[0, 0, 1]], None, None);
-        assert!(all_degenerate.unwrap_err().to_string().contains("zero area"));
+        assert!(
+            all_degenerate
+                .unwrap_err()
+                .to_string()
+                .contains("zero area")
+        );
     }
 }

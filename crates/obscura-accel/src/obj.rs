@@ -44,6 +44,9 @@ pub fn load_obj(path: &Path) -> Result<TriangleMesh, AccelError> {
     };
     scan(text).map_err(|(line, reason)| obj_error(Some(line), reason))?;
 
+    // tobj adds fields behind its "merging" and "reordering" features; keep their defaults if
+    // another crate in the build enables them.
+    #[allow(clippy::needless_update)]
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
@@ -51,12 +54,11 @@ pub fn load_obj(path: &Path) -> Result<TriangleMesh, AccelError> {
         ignore_lines: true,
         ..Default::default()
     };
-    let (models, _materials) = tobj::load_obj_buf(
-        &mut std::io::Cursor::new(text.as_bytes()),
-        &options,
-        |_| Err(tobj::LoadError::OpenFileFailed),
-    )
-    .map_err(|e| obj_error(None, format!("tobj could not parse the file: {e}")))?;
+    let (models, _materials) =
+        tobj::load_obj_buf(&mut std::io::Cursor::new(text.as_bytes()), &options, |_| {
+            Err(tobj::LoadError::OpenFileFailed)
+        })
+        .map_err(|e| obj_error(None, format!("tobj could not parse the file: {e}")))?;
 
     // Merge every model into one mesh, offsetting indices.
     let mut positions = Vec::new();
@@ -84,7 +86,11 @@ pub fn load_obj(path: &Path) -> Result<TriangleMesh, AccelError> {
             all_normals = false;
         }
         if mesh.texcoords.len() == count * 2 && count > 0 {
-            uvs.extend(mesh.texcoords.chunks_exact(2).map(|c| Vec2::new(c[0], c[1])));
+            uvs.extend(
+                mesh.texcoords
+                    .chunks_exact(2)
+                    .map(|c| Vec2::new(c[0], c[1])),
+            );
         } else if count > 0 {
             all_uvs = false;
         }
@@ -157,10 +163,7 @@ fn scan(text: &str) -> Result<(), (usize, String)> {
                 if args.len() < 3 {
                     return Err((
                         number,
-                        format!(
-                            "a face of {} vertices (at least 3 are needed)",
-                            args.len()
-                        ),
+                        format!("a face of {} vertices (at least 3 are needed)", args.len()),
                     ));
                 }
                 for a in &args {
@@ -189,8 +192,7 @@ fn scan(text: &str) -> Result<(), (usize, String)> {
                                 number,
                                 format!(
                                     "face{} index {index} out of range (the file has {total} {})",
-                                    names[k],
-                                    plurals[k]
+                                    names[k], plurals[k]
                                 ),
                             ));
                         }
@@ -216,7 +218,10 @@ mod tests {
         let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n\nf 1 2 3\nf 1 2 9\n";
         let (line, reason) = scan(text).unwrap_err();
         assert_eq!(line, 7);
-        assert_eq!(reason, "face index 9 out of range (the file has 4 vertices)");
+        assert_eq!(
+            reason,
+            "face index 9 out of range (the file has 4 vertices)"
+        );
     }
 
     #[test]

@@ -132,12 +132,13 @@ impl SceneBuilder {
                 }
             }
         }
-        let finite = |t: &Transform<World, Object>| {
-            t.matrix().is_finite() && t.inverse_matrix().is_finite()
-        };
+        let finite =
+            |t: &Transform<World, Object>| t.matrix().is_finite() && t.inverse_matrix().is_finite();
         let ok = match &placement {
             Placement::Static(t) => finite(t),
-            Placement::Moving(a) => a.keyframes().all(|(time, t)| time.is_finite() && finite(&t)),
+            Placement::Moving(a) => a
+                .keyframes()
+                .all(|(time, t)| time.is_finite() && finite(&t)),
         };
         if !ok {
             return Err(AccelError::Placement(
@@ -190,9 +191,8 @@ impl SceneBuilder {
                         // Flatten: carry the triangles to world space once.
                         let m = world_from_object.matrix();
                         for (i, _) in mesh.triangles().iter().enumerate() {
-                            let corners = mesh
-                                .corners(i)
-                                .map(|p| Vec3A::from(m.transform_point3(p)));
+                            let corners =
+                                mesh.corners(i).map(|p| Vec3A::from(m.transform_point3(p)));
                             flat_tris.push(corners);
                             flat_ids.push([instance, i as u32]);
                         }
@@ -216,10 +216,8 @@ impl SceneBuilder {
                 },
                 Shape::Sphere { center, radius } => {
                     let r = Vec3::splat(radius);
-                    let b = Bounds3::new(
-                        Point3::from_glam(center - r),
-                        Point3::from_glam(center + r),
-                    );
+                    let b =
+                        Bounds3::new(Point3::from_glam(center - r), Point3::from_glam(center + r));
                     item_bounds.push(xform.bounds(b));
                     items.push(Item::Analytic {
                         instance,
@@ -233,8 +231,13 @@ impl SceneBuilder {
                     edge_v,
                 } => {
                     let b = Bounds3::from_points(
-                        [origin, origin + edge_u, origin + edge_v, origin + edge_u + edge_v]
-                            .map(Point3::from_glam),
+                        [
+                            origin,
+                            origin + edge_u,
+                            origin + edge_v,
+                            origin + edge_u + edge_v,
+                        ]
+                        .map(Point3::from_glam),
                     );
                     item_bounds.push(xform.bounds(b));
                     items.push(Item::Analytic {
@@ -265,7 +268,10 @@ impl SceneBuilder {
             let ids = blas.prims.iter().map(|&i| flat_ids[i as usize]).collect();
             Some((blas, ids))
         };
-        if item_bounds.iter().any(|b| !b.min.is_finite() || !b.max.is_finite()) {
+        if item_bounds
+            .iter()
+            .any(|b| !b.min.is_finite() || !b.max.is_finite())
+        {
             return Err(AccelError::Placement(
                 "an instance's world bounds overflow (a transform is too large)".to_string(),
             ));
@@ -280,10 +286,17 @@ impl SceneBuilder {
                     // Pad flat boxes (a quad in an axis plane) by a relative hair.
                     let d = b.diagonal().to_glam().abs().max_element();
                     let pad = Vec3A::splat(d * 1e-6 + f32::MIN_POSITIVE);
-                    Aabb::new(Vec3A::from(b.min.to_glam()) - pad, Vec3A::from(b.max.to_glam()) + pad)
+                    Aabb::new(
+                        Vec3A::from(b.min.to_glam()) - pad,
+                        Vec3A::from(b.max.to_glam()) + pad,
+                    )
                 })
                 .collect::<Vec<_>>();
-            let bvh = build_cwbvh(&aabbs, BvhBuildParams::fast_build(), &mut Duration::default());
+            let bvh = build_cwbvh(
+                &aabbs,
+                BvhBuildParams::fast_build(),
+                &mut Duration::default(),
+            );
             let order = bvh.primitive_indices.clone();
             Some((bvh, order))
         } else {
@@ -428,10 +441,23 @@ enum Item {
 /// What a traversal found, enough to build the [`Hit`] afterwards.
 #[derive(Clone, Copy, Debug)]
 enum Found {
-    Flat { slot: usize, tri: TriangleHit },
-    Moving { item: usize, slot: usize, tri: TriangleHit },
-    Sphere { item: usize, t: f32 },
-    Quad { item: usize, quad: QuadHit },
+    Flat {
+        slot: usize,
+        tri: TriangleHit,
+    },
+    Moving {
+        item: usize,
+        slot: usize,
+        tri: TriangleHit,
+    },
+    Sphere {
+        item: usize,
+        t: f32,
+    },
+    Quad {
+        item: usize,
+        quad: QuadHit,
+    },
 }
 
 impl Found {
@@ -601,10 +627,13 @@ impl Scene {
     fn finish(&self, r: &PlainRay, found: Found) -> Hit {
         match found {
             Found::Flat { slot, tri } => {
-                let (blas, ids) = self.flat.as_ref().expect("a flat hit implies flat triangles");
+                let (blas, ids) = self
+                    .flat
+                    .as_ref()
+                    .expect("a flat hit implies flat triangles");
                 let [instance, primitive] = ids[slot];
-                let world_from_object = self.statics[instance as usize]
-                    .expect("flattened meshes are static");
+                let world_from_object =
+                    self.statics[instance as usize].expect("flattened meshes are static");
                 let mesh = self.meshes[instance as usize]
                     .as_ref()
                     .expect("flattened instances are meshes");
@@ -613,13 +642,22 @@ impl Scene {
                 // The world corners already carry the transform: (M a) x (M b) =
                 // det(M) M^-T (a x b), so flip for a mirroring transform to match the inverse
                 // transpose of the object-space winding normal.
-                let mut n_geo =
-                    (corners[1] - corners[0]).cross(corners[2] - corners[0]).normalize();
+                let mut n_geo = (corners[1] - corners[0])
+                    .cross(corners[2] - corners[0])
+                    .normalize();
                 if world_from_object.swaps_handedness() {
                     n_geo = -n_geo;
                 }
                 self.triangle_hit(
-                    r, tri, p, p_error, n_geo, mesh, primitive, instance, &world_from_object,
+                    r,
+                    tri,
+                    p,
+                    p_error,
+                    n_geo,
+                    mesh,
+                    primitive,
+                    instance,
+                    &world_from_object,
                 )
             }
             Found::Moving { item, slot, tri } => {
@@ -649,7 +687,15 @@ impl Scene {
                 let n_object = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
                 let n_geo = normal_to_world(&world_from_object, n_object);
                 self.triangle_hit(
-                    r, tri, p, p_error, n_geo, mesh, primitive, *instance, &world_from_object,
+                    r,
+                    tri,
+                    p,
+                    p_error,
+                    n_geo,
+                    mesh,
+                    primitive,
+                    *instance,
+                    &world_from_object,
                 )
             }
             Found::Sphere { item, t } => {
@@ -662,7 +708,11 @@ impl Scene {
                 // Reproject onto the surface: the error is then that of the projection.
                 let mut rel = p_hit - center;
                 let len = rel.length();
-                rel = if len > 0.0 { rel * (radius / len) } else { Vec3::new(0.0, 0.0, radius) };
+                rel = if len > 0.0 {
+                    rel * (radius / len)
+                } else {
+                    Vec3::new(0.0, 0.0, radius)
+                };
                 let p_object = center + rel;
                 let err_object = gamma(5) * rel.abs() + gamma(2) * p_object.abs();
                 let n_object = rel / radius;
@@ -676,7 +726,14 @@ impl Scene {
                     theta / core::f32::consts::PI,
                 );
                 self.analytic_hit(
-                    r, t, p_object, err_object, n_object, uv, instance, &world_from_object,
+                    r,
+                    t,
+                    p_object,
+                    err_object,
+                    n_object,
+                    uv,
+                    instance,
+                    &world_from_object,
                 )
             }
             Found::Quad { item, quad } => {
@@ -695,7 +752,14 @@ impl Scene {
                 let n_object = edge_u.cross(edge_v);
                 let uv = Vec2::new(quad.s, quad.v);
                 self.analytic_hit(
-                    r, quad.t, p_object, err_object, n_object, uv, instance, &world_from_object,
+                    r,
+                    quad.t,
+                    p_object,
+                    err_object,
+                    n_object,
+                    uv,
+                    instance,
+                    &world_from_object,
                 )
             }
         }

@@ -58,7 +58,10 @@ fn random_scene(seed: u64, moving_chance: f32) -> TestScene {
         let loaded = load_obj(&path).unwrap();
         std::fs::remove_file(&path).ok();
         assert_eq!(loaded.triangle_count(), from_file.triangle_count());
-        instances.push((Shape::Mesh(Arc::new(loaded)), random_placement(&mut rng, moving_chance)));
+        instances.push((
+            Shape::Mesh(Arc::new(loaded)),
+            random_placement(&mut rng, moving_chance),
+        ));
     }
     TestScene::build(instances)
 }
@@ -95,7 +98,10 @@ fn a_large_soup_matches_brute_force() {
     let mut rng = Rng(7);
     let soup = Arc::new(triangle_soup(&mut rng, 3000, 0.5));
     let scene = TestScene::build(vec![
-        (Shape::Mesh(soup.clone()), Placement::Static(Transform::IDENTITY)),
+        (
+            Shape::Mesh(soup.clone()),
+            Placement::Static(Transform::IDENTITY),
+        ),
         (Shape::Mesh(soup), random_placement(&mut Rng(99), 1.0)),
     ]);
     let mut hits = 0;

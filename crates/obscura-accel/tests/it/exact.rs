@@ -12,7 +12,11 @@ fn close(a: Vec3, b: Vec3) -> bool {
 }
 
 fn ray(o: [f32; 3], d: [f32; 3], time: f32) -> Ray<World> {
-    Ray::new(Point3::new(o[0], o[1], o[2]), Vector3::new(d[0], d[1], d[2]), time)
+    Ray::new(
+        Point3::new(o[0], o[1], o[2]),
+        Vector3::new(d[0], d[1], d[2]),
+        time,
+    )
 }
 
 fn one(shape: Shape, placement: Placement) -> Scene {
@@ -33,10 +37,15 @@ fn sphere_hit_point_normal_and_uv() {
     // t = 4. There rel = (0, 1, 0): theta = acos(0) = pi/2 so v = 1/2; phi = atan2(1, 0) = pi/2
     // so u = 1/4. The outward normal is +y.
     let scene = one(
-        Shape::Sphere { center: Vec3::new(0.0, 0.0, -5.0), radius: 1.0 },
+        Shape::Sphere {
+            center: Vec3::new(0.0, 0.0, -5.0),
+            radius: 1.0,
+        },
         Placement::Static(Transform::IDENTITY),
     );
-    let hit = scene.intersect(&ray([0.0, 5.0, -5.0], [0.0, -1.0, 0.0], 0.0)).unwrap();
+    let hit = scene
+        .intersect(&ray([0.0, 5.0, -5.0], [0.0, -1.0, 0.0], 0.0))
+        .unwrap();
     assert!((hit.t - 4.0).abs() < EPS);
     assert!(close(hit.p.to_glam(), Vec3::new(0.0, 1.0, -5.0)));
     assert!(close(hit.n_geometric.to_glam(), Vec3::Y));
@@ -52,7 +61,10 @@ fn sphere_hit_point_normal_and_uv() {
 fn ray_range_is_honoured() {
     // From the origin down -z the unit sphere at z = -5 is crossed at t = 4 and t = 6.
     let scene = one(
-        Shape::Sphere { center: Vec3::new(0.0, 0.0, -5.0), radius: 1.0 },
+        Shape::Sphere {
+            center: Vec3::new(0.0, 0.0, -5.0),
+            radius: 1.0,
+        },
         Placement::Static(Transform::IDENTITY),
     );
     let r = ray([0.0; 3], [0.0, 0.0, -1.0], 0.0);
@@ -60,7 +72,10 @@ fn ray_range_is_honoured() {
     let past_near = r.with_range(4.5, 10.0);
     assert!((scene.intersect(&past_near).unwrap().t - 6.0).abs() < EPS);
     // The far hit's normal is still outward (-z side is away from the centre at z = -6).
-    assert!(close(scene.intersect(&past_near).unwrap().n_geometric.to_glam(), -Vec3::Z));
+    assert!(close(
+        scene.intersect(&past_near).unwrap().n_geometric.to_glam(),
+        -Vec3::Z
+    ));
     let short = r.with_range(0.0, 3.9);
     assert!(scene.intersect(&short).is_none());
     assert!(!scene.occluded(&short));
@@ -76,10 +91,15 @@ fn mirrored_sphere_keeps_outward_normals() {
     // (3, 0, 0), object normal +x, and the inverse transpose of diag(-1, 1, 1) maps it to -x.
     let mirror = Transform::<World, Object>::scale(Vec3::new(-1.0, 1.0, 1.0)).unwrap();
     let scene = one(
-        Shape::Sphere { center: Vec3::new(2.0, 0.0, 0.0), radius: 1.0 },
+        Shape::Sphere {
+            center: Vec3::new(2.0, 0.0, 0.0),
+            radius: 1.0,
+        },
         Placement::Static(mirror),
     );
-    let hit = scene.intersect(&ray([-5.0, 0.0, 0.0], [1.0, 0.0, 0.0], 0.0)).unwrap();
+    let hit = scene
+        .intersect(&ray([-5.0, 0.0, 0.0], [1.0, 0.0, 0.0], 0.0))
+        .unwrap();
     assert!((hit.t - 2.0).abs() < EPS);
     assert!(close(hit.n_geometric.to_glam(), -Vec3::X));
 }
@@ -90,15 +110,25 @@ fn mirrored_quad_normal_and_uv() {
     // A ray from (0.5, 0.25, 3) down -z meets it at t = 3 with (s, t) = (0.5, 0.25).
     let mirror = Transform::<World, Object>::scale(Vec3::new(1.0, 1.0, -1.0)).unwrap();
     let scene = one(
-        Shape::Quad { origin: Vec3::ZERO, edge_u: Vec3::X, edge_v: Vec3::Y },
+        Shape::Quad {
+            origin: Vec3::ZERO,
+            edge_u: Vec3::X,
+            edge_v: Vec3::Y,
+        },
         Placement::Static(mirror),
     );
-    let hit = scene.intersect(&ray([0.5, 0.25, 3.0], [0.0, 0.0, -1.0], 0.0)).unwrap();
+    let hit = scene
+        .intersect(&ray([0.5, 0.25, 3.0], [0.0, 0.0, -1.0], 0.0))
+        .unwrap();
     assert!((hit.t - 3.0).abs() < EPS);
     assert!(close(hit.n_geometric.to_glam(), -Vec3::Z));
     assert!((hit.uv - Vec2::new(0.5, 0.25)).abs().max_element() < EPS);
     // Outside the parallelogram (s = 1.5): a miss.
-    assert!(scene.intersect(&ray([1.5, 0.25, 3.0], [0.0, 0.0, -1.0], 0.0)).is_none());
+    assert!(
+        scene
+            .intersect(&ray([1.5, 0.25, 3.0], [0.0, 0.0, -1.0], 0.0))
+            .is_none()
+    );
 }
 
 #[test]
@@ -110,7 +140,9 @@ fn flattened_triangle_uv_and_shading_normal() {
     let mesh = unit_triangle(Some(vec![-Vec3::Z; 3]));
     let scale = Transform::<World, Object>::scale(Vec3::splat(2.0)).unwrap();
     let scene = one(Shape::Mesh(mesh), Placement::Static(scale));
-    let hit = scene.intersect(&ray([0.5, 1.0, 5.0], [0.0, 0.0, -1.0], 0.0)).unwrap();
+    let hit = scene
+        .intersect(&ray([0.5, 1.0, 5.0], [0.0, 0.0, -1.0], 0.0))
+        .unwrap();
     assert!((hit.t - 5.0).abs() < EPS);
     assert!(close(hit.p.to_glam(), Vec3::new(0.5, 1.0, 0.0)));
     assert!((hit.uv - Vec2::new(0.25, 0.5)).abs().max_element() < EPS);
@@ -127,7 +159,9 @@ fn mirrored_triangles_keep_their_winding_normal_static_and_moving() {
     let moving = AnimatedTransform::new(mirror, 0.0, shifted, 1.0).unwrap();
     for placement in [Placement::Static(mirror), Placement::Moving(moving)] {
         let scene = one(Shape::Mesh(unit_triangle(None)), placement);
-        let hit = scene.intersect(&ray([0.25, 0.25, 5.0], [0.0, 0.0, -1.0], 0.0)).unwrap();
+        let hit = scene
+            .intersect(&ray([0.25, 0.25, 5.0], [0.0, 0.0, -1.0], 0.0))
+            .unwrap();
         assert!((hit.t - 5.0).abs() < EPS);
         assert!(close(hit.n_geometric.to_glam(), -Vec3::Z));
         // The vertex uvs are the unit corners, so uv = (b1, b2) = (0.25, 0.25).
@@ -163,15 +197,24 @@ fn moving_triangle_is_where_its_keyframes_say() {
 #[test]
 fn instances_are_numbered_in_call_order_and_bounds_cover_them() {
     let mut b = SceneBuilder::new();
-    let sphere = |x: f32| Shape::Sphere { center: Vec3::new(x, 0.0, 0.0), radius: 0.5 };
+    let sphere = |x: f32| Shape::Sphere {
+        center: Vec3::new(x, 0.0, 0.0),
+        radius: 0.5,
+    };
     for (i, x) in [0.0, 3.0, 6.0].into_iter().enumerate() {
-        assert_eq!(b.add(sphere(x), Placement::Static(Transform::IDENTITY)).unwrap(), i as u32);
+        assert_eq!(
+            b.add(sphere(x), Placement::Static(Transform::IDENTITY))
+                .unwrap(),
+            i as u32
+        );
     }
     let scene = b.build().unwrap();
     assert_eq!(scene.instance_count(), 3);
     // A ray along +x from x = 10 backwards meets the sphere at x = 6 first (instance 2, at
     // x = 6.5, t = 3.5).
-    let hit = scene.intersect(&ray([10.0, 0.0, 0.0], [-1.0, 0.0, 0.0], 0.0)).unwrap();
+    let hit = scene
+        .intersect(&ray([10.0, 0.0, 0.0], [-1.0, 0.0, 0.0], 0.0))
+        .unwrap();
     assert_eq!(hit.instance, 2);
     assert!((hit.t - 3.5).abs() < EPS);
     let bounds = scene.bounds();
@@ -182,9 +225,31 @@ fn instances_are_numbered_in_call_order_and_bounds_cover_them() {
 fn invalid_input_is_refused_not_panicked_on() {
     let mut b = SceneBuilder::new();
     let fixed = || Placement::Static(Transform::IDENTITY);
-    assert!(b.add(Shape::Sphere { center: Vec3::ZERO, radius: 0.0 }, fixed()).is_err());
-    assert!(b.add(Shape::Sphere { center: Vec3::NAN, radius: 1.0 }, fixed()).is_err());
-    let flat = Shape::Quad { origin: Vec3::ZERO, edge_u: Vec3::X, edge_v: Vec3::X * 2.0 };
+    assert!(
+        b.add(
+            Shape::Sphere {
+                center: Vec3::ZERO,
+                radius: 0.0
+            },
+            fixed()
+        )
+        .is_err()
+    );
+    assert!(
+        b.add(
+            Shape::Sphere {
+                center: Vec3::NAN,
+                radius: 1.0
+            },
+            fixed()
+        )
+        .is_err()
+    );
+    let flat = Shape::Quad {
+        origin: Vec3::ZERO,
+        edge_u: Vec3::X,
+        edge_v: Vec3::X * 2.0,
+    };
     let err = b.add(flat, fixed()).unwrap_err();
     assert!(err.to_string().contains("parallel"), "{err}");
     // Nothing was added: the scene is empty and answers every ray with a miss.
@@ -195,7 +260,10 @@ fn invalid_input_is_refused_not_panicked_on() {
 
     // Rays that cannot hit anything are misses, not panics.
     let scene = one(
-        Shape::Sphere { center: Vec3::ZERO, radius: 1.0 },
+        Shape::Sphere {
+            center: Vec3::ZERO,
+            radius: 1.0,
+        },
         Placement::Static(Transform::IDENTITY),
     );
     for bad in [

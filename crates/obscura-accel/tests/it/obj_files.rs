@@ -18,7 +18,10 @@ fn error_of(name: &str, contents: &[u8]) -> (AccelError, String) {
     let path = fixture(name, contents);
     let err = load_obj(&path).expect_err("a bad file must be an error");
     let message = err.to_string();
-    assert!(message.contains(name), "the message must name the file: {message}");
+    assert!(
+        message.contains(name),
+        "the message must name the file: {message}"
+    );
     (err, message)
 }
 
@@ -59,7 +62,10 @@ fn normals_and_uvs_are_kept_and_degenerate_faces_counted() {
 fn missing_file_is_named() {
     let path = std::env::temp_dir().join("obscura-accel-no-such-file.obj");
     let message = load_obj(&path).unwrap_err().to_string();
-    assert!(message.contains("obscura-accel-no-such-file.obj"), "{message}");
+    assert!(
+        message.contains("obscura-accel-no-such-file.obj"),
+        "{message}"
+    );
     assert!(message.contains("cannot read"), "{message}");
 }
 
@@ -67,13 +73,21 @@ fn missing_file_is_named() {
 fn out_of_range_index_names_the_line() {
     // Line 5 is the face; the file has 4 vertices.
     let (err, message) = error_of("bad_index.obj", format!("{SQUARE}f 1 2 9\n").as_bytes());
-    assert!(matches!(err, AccelError::Obj { line: Some(5), .. }), "{message}");
     assert!(
-        message.ends_with("bad_index.obj: line 5: face index 9 out of range (the file has 4 vertices)"),
+        matches!(err, AccelError::Obj { line: Some(5), .. }),
+        "{message}"
+    );
+    assert!(
+        message.ends_with(
+            "bad_index.obj: line 5: face index 9 out of range (the file has 4 vertices)"
+        ),
         "{message}"
     );
     // Negative indices count back: -5 is before the first vertex.
-    let (_, message) = error_of("bad_negative.obj", format!("{SQUARE}f -1 -2 -5\n").as_bytes());
+    let (_, message) = error_of(
+        "bad_negative.obj",
+        format!("{SQUARE}f -1 -2 -5\n").as_bytes(),
+    );
     assert!(message.contains("line 5"), "{message}");
 }
 
@@ -81,26 +95,47 @@ fn out_of_range_index_names_the_line() {
 fn truncated_files_name_the_line() {
     // The last vertex lost its z (line 4), or the last face lost its vertices (line 5).
     let (_, message) = error_of("truncated_v.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1");
-    assert!(message.contains("line 4") && message.contains("truncated"), "{message}");
+    assert!(
+        message.contains("line 4") && message.contains("truncated"),
+        "{message}"
+    );
     let (_, message) = error_of("truncated_f.obj", format!("{SQUARE}f 1 2").as_bytes());
-    assert!(message.contains("line 5") && message.contains("at least 3"), "{message}");
+    assert!(
+        message.contains("line 5") && message.contains("at least 3"),
+        "{message}"
+    );
     // A number cut in the middle of its exponent does not parse.
     let (_, message) = error_of("truncated_num.obj", b"v 0 0 0\nv 1 0 1e\n");
-    assert!(message.contains("line 2") && message.contains("cannot parse"), "{message}");
+    assert!(
+        message.contains("line 2") && message.contains("cannot parse"),
+        "{message}"
+    );
 }
 
 #[test]
 fn faces_of_fewer_than_three_vertices_are_errors() {
-    let (_, message) = error_of("two_vertex_face.obj", format!("{SQUARE}\nf 1 2 3\nf 1 2\n").as_bytes());
-    assert!(message.contains("line 7") && message.contains("a face of 2 vertices"), "{message}");
+    let (_, message) = error_of(
+        "two_vertex_face.obj",
+        format!("{SQUARE}\nf 1 2 3\nf 1 2\n").as_bytes(),
+    );
+    assert!(
+        message.contains("line 7") && message.contains("a face of 2 vertices"),
+        "{message}"
+    );
 }
 
 #[test]
 fn nan_and_infinite_coordinates_are_errors() {
     let (_, message) = error_of("nan.obj", b"v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n");
-    assert!(message.contains("line 2") && message.contains("NaN"), "{message}");
+    assert!(
+        message.contains("line 2") && message.contains("NaN"),
+        "{message}"
+    );
     let (_, message) = error_of("inf.obj", b"v 0 0 0\nv 1 0 0\nv 0 inf 0\nf 1 2 3\n");
-    assert!(message.contains("line 3") && message.contains("infinite"), "{message}");
+    assert!(
+        message.contains("line 3") && message.contains("infinite"),
+        "{message}"
+    );
 }
 
 #[test]
@@ -110,23 +145,37 @@ fn an_empty_mesh_is_an_error() {
     let (_, message) = error_of("empty.obj", b"");
     assert!(message.contains("no faces"), "{message}");
     // Faces that all have zero area leave nothing either.
-    let (_, message) = error_of("all_degenerate.obj", format!("{SQUARE}f 1 1 2\n").as_bytes());
+    let (_, message) = error_of(
+        "all_degenerate.obj",
+        format!("{SQUARE}f 1 1 2\n").as_bytes(),
+    );
     assert!(message.contains("zero area"), "{message}");
 }
 
 #[test]
 fn a_binary_file_is_refused() {
     // The start of a PNG file, renamed .obj.
-    let png = [0x89, b'P', b'N', b'G', b'\r', b'\n', 0x1a, b'\n', 0, 0, 0, 13, b'I', b'H'];
+    let png = [
+        0x89, b'P', b'N', b'G', b'\r', b'\n', 0x1a, b'\n', 0, 0, 0, 13, b'I', b'H',
+    ];
     let (_, message) = error_of("image.obj", &png);
     assert!(message.contains("not a text OBJ file"), "{message}");
     // Invalid UTF-8 without a NUL byte is refused too.
     let (_, message) = error_of("latin1.obj", b"v 0 0 0\n\xff\xfe garbage\n");
-    assert!(message.contains("line 2") && message.contains("not a text OBJ file"), "{message}");
+    assert!(
+        message.contains("line 2") && message.contains("not a text OBJ file"),
+        "{message}"
+    );
 }
 
 #[test]
 fn garbage_statements_name_the_line() {
-    let (_, message) = error_of("garbage.obj", format!("{SQUARE}f 1 2 3\nhello world\n").as_bytes());
-    assert!(message.contains("line 6") && message.contains("unknown statement"), "{message}");
+    let (_, message) = error_of(
+        "garbage.obj",
+        format!("{SQUARE}f 1 2 3\nhello world\n").as_bytes(),
+    );
+    assert!(
+        message.contains("line 6") && message.contains("unknown statement"),
+        "{message}"
+    );
 }

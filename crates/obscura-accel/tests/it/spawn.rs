@@ -36,7 +36,7 @@ proptest! {
         let mut checked = 0;
         for _ in 0..300 {
             let mut ray = random_ray(&mut rng);
-            ray.origin = ray.origin + Vector3::from_glam(shift);
+            ray.origin += Vector3::from_glam(shift);
             let Some(hit) = scene.intersect(&ray) else { continue };
             let n = hit.n_geometric.to_glam();
             let is_sphere = shapes[hit.instance as usize];
@@ -75,10 +75,29 @@ fn spawn_ray_to_stops_short_of_its_target() {
     // by the sphere's bottom at t = 1/2.
     let mut b = SceneBuilder::new();
     let fixed = || Placement::Static(Transform::IDENTITY);
-    b.add(Shape::Quad { origin: Vec3::new(-1.0, -1.0, 0.0), edge_u: Vec3::X * 2.0, edge_v: Vec3::Y * 2.0 }, fixed()).unwrap();
-    b.add(Shape::Sphere { center: Vec3::new(0.0, 0.0, 3.0), radius: 1.0 }, fixed()).unwrap();
+    b.add(
+        Shape::Quad {
+            origin: Vec3::new(-1.0, -1.0, 0.0),
+            edge_u: Vec3::X * 2.0,
+            edge_v: Vec3::Y * 2.0,
+        },
+        fixed(),
+    )
+    .unwrap();
+    b.add(
+        Shape::Sphere {
+            center: Vec3::new(0.0, 0.0, 3.0),
+            radius: 1.0,
+        },
+        fixed(),
+    )
+    .unwrap();
     let scene = b.build().unwrap();
-    let down = obscura_space::Ray::new(Point3::new(0.0, 0.0, 1.5), Vector3::new(0.0, 0.0, -1.0), 0.0);
+    let down = obscura_space::Ray::new(
+        Point3::new(0.0, 0.0, 1.5),
+        Vector3::new(0.0, 0.0, -1.0),
+        0.0,
+    );
     let hit = scene.intersect(&down).unwrap();
     assert_eq!(hit.instance, 0);
     assert!(!scene.occluded(&hit.spawn_ray_to(Point3::new(0.0, 0.0, 2.0))));
