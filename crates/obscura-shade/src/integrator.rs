@@ -76,6 +76,13 @@ impl ShadingScene {
                     count: instance_material.len(),
                 });
             };
+            if slot.is_some() {
+                return Err(ShadeError::BadIndex {
+                    what: "emitter instance (listed twice)".to_string(),
+                    index: instance,
+                    count: instance_material.len(),
+                });
+            }
             if emission == Vec3::ZERO {
                 continue;
             }

@@ -199,19 +199,45 @@ impl AreaLight {
     ) -> Result<AreaLight, ShadeError> {
         check_non_negative(emission, "emission")?;
         let shape = match shape {
-            Shape::Sphere { center, radius } => EmitterShape::Sphere {
-                center: *center,
-                radius: *radius,
-            },
+            Shape::Sphere { center, radius } => {
+                if !center.is_finite() || !radius.is_finite() {
+                    return Err(ShadeError::NotFinite {
+                        parameter: "emissive sphere",
+                    });
+                }
+                if *radius <= 0.0 {
+                    return Err(ShadeError::OutOfRange {
+                        parameter: "emissive sphere radius",
+                        expected: "greater than 0",
+                    });
+                }
+                EmitterShape::Sphere {
+                    center: *center,
+                    radius: *radius,
+                }
+            }
             Shape::Quad {
                 origin,
                 edge_u,
                 edge_v,
-            } => EmitterShape::Quad {
-                origin: *origin,
-                edge_u: *edge_u,
-                edge_v: *edge_v,
-            },
+            } => {
+                if !(origin.is_finite() && edge_u.is_finite() && edge_v.is_finite()) {
+                    return Err(ShadeError::NotFinite {
+                        parameter: "emissive quad",
+                    });
+                }
+                if edge_u.cross(*edge_v).length_squared() <= 0.0 {
+                    return Err(ShadeError::OutOfRange {
+                        parameter: "emissive quad edges",
+                        expected: "non-parallel and non-zero (the quad needs an area)",
+                    });
+                }
+                EmitterShape::Quad {
+                    origin: *origin,
+                    edge_u: *edge_u,
+                    edge_v: *edge_v,
+                }
+            }
             Shape::Mesh(mesh) => {
                 let positions = mesh.positions();
                 let mut triangles = Vec::with_capacity(mesh.triangles().len());

@@ -482,3 +482,79 @@ fn mis_weight_hand_values() {
     assert_eq!(power_heuristic(2.0, 0.0), 1.0);
     let _ = Vec2::ZERO;
 }
+
+#[test]
+fn shading_scene_rejects_bad_input_with_clear_messages() {
+    let sphere = || Shape::Sphere {
+        center: Vec3::ZERO,
+        radius: 1.0,
+    };
+    let e = ShadingScene::new(vec![white()], vec![0, 1], vec![], vec![]).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "instance_material[1] = 1 is out of range (there are 1)"
+    );
+    let e = ShadingScene::new(
+        vec![white()],
+        vec![0],
+        vec![],
+        vec![(4, sphere(), fixed(), Vec3::ONE)],
+    )
+    .unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "emitter instance = 4 is out of range (there are 1)"
+    );
+    let twice = vec![
+        (0, sphere(), fixed(), Vec3::ONE),
+        (0, sphere(), fixed(), Vec3::ONE),
+    ];
+    assert!(ShadingScene::new(vec![white()], vec![0], vec![], twice).is_err());
+    let e = ShadingScene::new(
+        vec![Material::Dielectric { ior: f32::NAN }],
+        vec![0],
+        vec![],
+        vec![],
+    )
+    .unwrap_err();
+    assert_eq!(e.to_string(), "ior must be finite (no NaN or infinity)");
+    let e = ShadingScene::new(
+        vec![white()],
+        vec![0],
+        vec![],
+        vec![(0, sphere(), fixed(), Vec3::new(1.0, -1.0, 0.0))],
+    )
+    .unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "emission must be at least 0 in every channel"
+    );
+    let flat = Shape::Quad {
+        origin: Vec3::ZERO,
+        edge_u: Vec3::X,
+        edge_v: Vec3::X * 2.0,
+    };
+    let e = ShadingScene::new(
+        vec![white()],
+        vec![0],
+        vec![],
+        vec![(0, flat, fixed(), Vec3::ONE)],
+    )
+    .unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "emissive quad edges must be non-parallel and non-zero (the quad needs an area)"
+    );
+    // A valid scene: the emitter becomes the last light and belongs to its instance.
+    let ok = ShadingScene::new(
+        vec![white()],
+        vec![0, 0],
+        vec![Light::point(Vec3::Y, Vec3::ONE).unwrap()],
+        vec![(1, sphere(), fixed(), Vec3::ONE)],
+    )
+    .unwrap();
+    assert_eq!(ok.lights().len(), 2);
+    assert_eq!(ok.area_light(1).map(|a| a.instance()), Some(1));
+    assert!(ok.area_light(0).is_none());
+    assert_eq!(ok.light_select_pdf(), 0.5);
+}
