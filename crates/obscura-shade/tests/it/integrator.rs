@@ -558,3 +558,35 @@ fn shading_scene_rejects_bad_input_with_clear_messages() {
     assert!(ok.area_light(0).is_none());
     assert_eq!(ok.light_select_pdf(), 0.5);
 }
+
+#[test]
+fn white_furnace_glass_and_mirror_spheres() {
+    // Lossless delta BSDFs alone: glass (paths bounce inside, with total internal reflection)
+    // and a mirror of reflectance 1 must vanish into a uniform environment too.
+    furnace(
+        vec![(
+            Shape::Sphere {
+                center: Vec3::ZERO,
+                radius: 1.0,
+            },
+            fixed(),
+            Material::Dielectric { ior: 1.5 },
+            Vec3::ZERO,
+        )],
+        "glass sphere",
+    );
+    furnace(
+        vec![(
+            Shape::Sphere {
+                center: Vec3::ZERO,
+                radius: 1.0,
+            },
+            fixed(),
+            Material::Mirror {
+                reflectance: Vec3::ONE,
+            },
+            Vec3::ZERO,
+        )],
+        "mirror sphere",
+    );
+}
