@@ -1,0 +1,345 @@
+//! From a validated [`SceneDescription`] to the objects that render it: the camera, the
+//! accelerator's scene, the shading scene and the sampler.
+
+use crate::error::RenderError;
+use crate::film::{Filter, PixelRect};
+use crate::scene::{
+    CameraKind, CameraSettings, IntegratorKind, LightSettings, MaterialSettings, SceneDescription,
+    ShapeGeometry,
+};
+use glam::Vec3;
+use obscura_accel::{Placement, Scene, SceneBuilder, Shape, TriangleMesh};
+use obscura_camera::{
+    AnyCamera, CameraBase, EnvironmentCamera, FilmGeometry, FovAxis, OrthographicCamera,
+    PerspectiveCamera, ScreenWindow, Shutter, ThinLens, look_at_pose,
+};
+use obscura_sample::Sampler;
+use obscura_shade::{EnvironmentLight, Light, Material, ShadingScene};
+use obscura_space::{AnimatedTransform, Point3, Vector3};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// Bytes of memory the renderer needs per pixel of the film: the f64 sums (40), the resolved
+/// f32 image (16) and the 8-bit copy for PNG (4), plus a margin for tile buffers (1.5x sums).
+pub const BYTES_PER_PIXEL: u64 = 40 + 16 + 4 + 60;
+
+/// A scene ready to render.
+pub struct RenderScene {
+    /// What the file said (after command-line overrides).
+    pub description: SceneDescription,
+    /// The camera.
+    pub camera: AnyCamera,
+    /// The geometry and its BVHs.
+    pub geometry: Scene,
+    /// Materials and lights.
+    pub shading: ShadingScene,
+    /// The sampler.
+    pub sampler: Sampler,
+    /// The reconstruction filter.
+    pub filter: Filter,
+    /// The pixels to render (the crop window).
+    pub pixel_bounds: PixelRect,
+    /// Triangles skipped as degenerate while loading meshes, per file.
+    pub skipped_triangles: Vec<(PathBuf, usize)>,
+}
+
+/// The grey diffuse that shapes without a `material` key get.
+pub const DEFAULT_MATERIAL: Material = Material::Diffuse {
+    reflectance: Vec3::splat(0.5),
+};
+
+impl RenderScene {
+    /// Builds everything the description names: loads meshes and maps, makes the camera.
+    pub fn build(description: SceneDescription) -> Result<RenderScene, RenderError> {
+        let d = &description;
+        let file = d.file.clone();
+        check_memory(&file, d.film.resolution)?;
+        let camera = build_camera(&file, &d.camera, d.film.resolution, d.film.crop)?;
+        let [x0, x1, y0, y1] = obscura_camera::Camera::film(&camera).pixel_bounds();
+        let pixel_bounds = PixelRect { x0, y0, x1, y1 };
+
+        // Materials: the file's, then the default grey for shapes that name none.
+        let mut materials: Vec<Material> = d.materials.iter().map(|(_, m)| material(*m)).collect();
+        let default_index = materials.len() as u32;
+        materials.push(DEFAULT_MATERIAL);
+
+        let mut builder = SceneBuilder::new();
+        let mut instance_material = Vec::new();
+        let mut emitters = Vec::new();
+        let mut meshes: HashMap<PathBuf, Arc<TriangleMesh>> = HashMap::new();
+        let mut skipped_triangles = Vec::new();
+        for s in &d.shapes {
+            let key = format!("shapes[{}]", s.index);
+            let shape = match &s.geometry {
+                ShapeGeometry::Sphere { center, radius } => Shape::Sphere {
+                    center: (*center).into(),
+                    radius: *radius,
+                },
+                ShapeGeometry::Quad {
+                    origin,
+                    edge_u,
+                    edge_v,
+                } => Shape::Quad {
+                    origin: (*origin).into(),
+                    edge_u: (*edge_u).into(),
+                    edge_v: (*edge_v).into(),
+                },
+                ShapeGeometry::Mesh { file: mesh_file } => {
+                    let mesh = match meshes.get(mesh_file) {
+                        Some(m) => m.clone(),
+                        None => {
+                            let m = Arc::new(obscura_accel::load_obj(mesh_file).map_err(|e| {
+                                RenderError::scene(
+                                    file.clone(),
+                                    format!("{key}.file"),
+                                    e.to_string(),
+                                )
+                            })?);
+                            if m.skipped_degenerate() > 0 {
+                                skipped_triangles.push((mesh_file.clone(), m.skipped_degenerate()));
+                            }
+                            meshes.insert(mesh_file.clone(), m.clone());
+                            m
+                        }
+                    };
+                    Shape::Mesh(mesh)
+                }
+            };
+            let placement = match s.transform_end {
+                Some(end) if end != s.transform && d.camera.shutter[0] < d.camera.shutter[1] => {
+                    Placement::Moving(
+                        AnimatedTransform::new(
+                            s.transform,
+                            d.camera.shutter[0],
+                            end,
+                            d.camera.shutter[1],
+                        )
+                        .map_err(|e| {
+                            RenderError::scene(
+                                file.clone(),
+                                format!("{key}.transform_end"),
+                                e.to_string(),
+                            )
+                        })?,
+                    )
+                }
+                _ => Placement::Static(s.transform),
+            };
+            let instance = builder
+                .add(shape.clone(), placement.clone())
+                .map_err(|e| RenderError::scene(file.clone(), key.clone(), e.to_string()))?;
+            instance_material.push(s.material.map_or(default_index, |m| m as u32));
+            if let Some(e) = s.emission {
+                emitters.push((instance, shape, placement, Vec3::from(e)));
+            }
+        }
+        let geometry = builder
+            .build()
+            .map_err(|e| RenderError::scene(file.clone(), "shapes", e.to_string()))?;
+
+        let mut lights = Vec::new();
+        for (i, l) in d.lights.iter().enumerate() {
+            let key = format!("lights[{i}]");
+            let light = match l {
+                LightSettings::Point {
+                    position,
+                    intensity,
+                } => Light::point((*position).into(), (*intensity).into()),
+                LightSettings::Distant {
+                    direction,
+                    irradiance,
+                } => Light::distant((*direction).into(), (*irradiance).into()),
+                LightSettings::Environment {
+                    radiance,
+                    file: None,
+                    transform: _,
+                } => EnvironmentLight::constant((*radiance).into()).map(Light::Environment),
+                LightSettings::Environment {
+                    radiance,
+                    file: Some(map),
+                    transform,
+                } => {
+                    let (w, h, texels) = read_environment_map(map).map_err(|message| {
+                        RenderError::scene(file.clone(), format!("{key}.file"), message)
+                    })?;
+                    let scale = Vec3::from(*radiance);
+                    let texels = texels.into_iter().map(|t| t * scale).collect();
+                    EnvironmentLight::from_texels(w, h, texels, transform.matrix())
+                        .map(Light::Environment)
+                }
+            }
+            .map_err(|e| RenderError::scene(file.clone(), key, e.to_string()))?;
+            lights.push(light);
+        }
+        let shading = ShadingScene::new(materials, instance_material, lights, emitters)
+            .map_err(|e| RenderError::scene(file.clone(), "lights", e.to_string()))?;
+        let sampler = Sampler::new(d.sampler.kind, d.sampler.spp, d.sampler.seed)
+            .map_err(|e| RenderError::scene(file.clone(), "sampler", e.to_string()))?;
+        let filter = Filter::new(d.film.filter);
+        Ok(RenderScene {
+            description,
+            camera,
+            geometry,
+            shading,
+            sampler,
+            filter,
+            pixel_bounds,
+            skipped_triangles,
+        })
+    }
+
+    /// The integrator this scene renders with.
+    pub fn integrator(&self) -> IntegratorKind {
+        self.description.integrator.kind
+    }
+}
+
+/// Refuses, up front, a film that would not fit in memory, saying how much it needs.
+fn check_memory(file: &Path, resolution: [u32; 2]) -> Result<(), RenderError> {
+    let pixels = u64::from(resolution[0]) * u64::from(resolution[1]);
+    let need = pixels.saturating_mul(BYTES_PER_PIXEL);
+    let available = available_memory();
+    if need > available {
+        return Err(RenderError::scene(
+            file,
+            "film.resolution",
+            format!(
+                "a {}x{} film needs {} of memory, more than the {} available",
+                resolution[0],
+                resolution[1],
+                human_bytes(need),
+                human_bytes(available)
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// MemAvailable from /proc/meminfo, else 16 GiB.
+fn available_memory() -> u64 {
+    let fallback = 16 << 30;
+    let Ok(info) = std::fs::read_to_string("/proc/meminfo") else {
+        return fallback;
+    };
+    info.lines()
+        .find_map(|l| l.strip_prefix("MemAvailable:"))
+        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<u64>().ok())
+        .map_or(fallback, |kb| kb * 1024)
+}
+
+/// `1.5 GiB`, `320.0 MiB`.
+pub fn human_bytes(b: u64) -> String {
+    const UNITS: [&str; 5] = ["B", "KiB", "MiB", "GiB", "TiB"];
+    let mut v = b as f64;
+    let mut u = 0;
+    while v >= 1024.0 && u + 1 < UNITS.len() {
+        v /= 1024.0;
+        u += 1;
+    }
+    if u == 0 {
+        format!("{b} B")
+    } else {
+        format!("{v:.1} {}", UNITS[u])
+    }
+}
+
+fn material(m: MaterialSettings) -> Material {
+    match m {
+        MaterialSettings::Diffuse { reflectance } => Material::Diffuse {
+            reflectance: reflectance.into(),
+        },
+        MaterialSettings::Mirror { reflectance } => Material::Mirror {
+            reflectance: reflectance.into(),
+        },
+        MaterialSettings::Dielectric { ior } => Material::Dielectric { ior },
+        MaterialSettings::RoughConductor {
+            reflectance,
+            roughness,
+        } => Material::RoughConductor {
+            reflectance: reflectance.into(),
+            roughness,
+        },
+    }
+}
+
+fn point(v: [f32; 3]) -> Point3<obscura_space::World> {
+    Point3::new(v[0], v[1], v[2])
+}
+
+fn build_camera(
+    file: &Path,
+    c: &CameraSettings,
+    resolution: [u32; 2],
+    crop: Option<[f32; 4]>,
+) -> Result<AnyCamera, RenderError> {
+    let err = |key: &str| {
+        let file = file.to_path_buf();
+        let key = key.to_string();
+        move |e: obscura_camera::CameraError| RenderError::scene(file, key, e.to_string())
+    };
+    let shutter = Shutter::new(c.shutter[0], c.shutter[1]).map_err(err("camera.shutter"))?;
+    let look = |l: &crate::scene::LookAt| {
+        (
+            point(l.eye),
+            point(l.target),
+            Vector3::new(l.up[0], l.up[1], l.up[2]),
+        )
+    };
+    let pose =
+        look_at_pose(look(&c.start), c.end.as_ref().map(look), shutter).map_err(err("camera"))?;
+    let window = match c.screen_window {
+        Some(w) => {
+            Some(ScreenWindow::new(w[0], w[1], w[2], w[3]).map_err(err("camera.screen_window"))?)
+        }
+        None => None,
+    };
+    let film = FilmGeometry::new(resolution, window, crop).map_err(err("film.resolution"))?;
+    let base = CameraBase::new(pose, shutter, film).with_clip(c.near, c.far);
+    let lens = || -> Result<ThinLens, RenderError> {
+        ThinLens::new(c.lens_radius, c.focal_distance)
+            .and_then(|l| l.with_blades(c.aperture_blades, c.aperture_rotation))
+            .map_err(err("camera.lens_radius"))
+    };
+    Ok(match c.kind {
+        CameraKind::Perspective => {
+            let axis: FovAxis = c.fov_axis.parse().map_err(err("camera.fov_axis"))?;
+            AnyCamera::Perspective(
+                PerspectiveCamera::new(base, c.fov, axis, lens()?).map_err(err("camera"))?,
+            )
+        }
+        CameraKind::Orthographic => {
+            AnyCamera::Orthographic(OrthographicCamera::new(base, lens()?).map_err(err("camera"))?)
+        }
+        CameraKind::Environment => {
+            AnyCamera::Environment(EnvironmentCamera::new(base).map_err(err("camera"))?)
+        }
+    })
+}
+
+/// Reads an equirectangular EXR as linear RGB texels, row 0 at the top.
+fn read_environment_map(path: &Path) -> Result<(u32, u32, Vec<Vec3>), String> {
+    let (image, _) = crate::output::read_exr(path).map_err(|e| match e {
+        RenderError::Encode { message, .. } if !path.exists() => {
+            format!("{}: file not found ({message})", path.display())
+        }
+        other => other.to_string(),
+    })?;
+    let texels: Vec<Vec3> = image
+        .pixels
+        .iter()
+        .map(|p| Vec3::new(p[0], p[1], p[2]))
+        .collect();
+    if let Some(i) = texels
+        .iter()
+        .position(|t| !t.is_finite() || t.min_element() < 0.0)
+    {
+        return Err(format!(
+            "{}: texel ({}, {}) is negative, NaN or infinite",
+            path.display(),
+            i as u32 % image.width,
+            i as u32 / image.width
+        ));
+    }
+    Ok((image.width, image.height, texels))
+}

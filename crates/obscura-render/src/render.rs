@@ -1,0 +1,249 @@
+//! The parallel tile renderer: passes of one sample per pixel over tiles, merged in order.
+//!
+//! A render is a sequence of passes; pass `k` takes sample index `k` of every pixel. Within a
+//! pass, tiles are rendered in parallel (rayon) into their own buffers, and merged into the
+//! film in tile order. The pass schedule depends only on the scene, never on threads or timing,
+//! so a render is bit-identical for any thread count, and a render stopped after pass `k` and
+//! resumed from there equals one that ran straight through.
+
+use crate::build::RenderScene;
+use crate::film::{Film, PixelRect, TileBuffer};
+use crate::scene::IntegratorKind;
+use glam::{Vec2, Vec3};
+use obscura_camera::{Camera, CameraSample};
+use obscura_sample::SampleStream;
+use obscura_shade::PathIntegrator;
+use obscura_space::{Point2, Ray, World};
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::time::{Duration, Instant};
+
+/// Tile edge in pixels.
+pub const TILE_SIZE: u32 = 16;
+
+/// How many tiles are rendered before they are merged (bounds the memory of tile buffers).
+const TILES_PER_BATCH: usize = 64;
+
+/// Counters of a render.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RenderStats {
+    /// Camera samples taken (one camera ray each).
+    pub samples: u64,
+    /// Samples whose radiance was NaN or infinite, dropped rather than splatted.
+    pub dropped_nonfinite: u64,
+    /// Samples for which the camera produced no ray (e.g. a zero-weight lens point).
+    pub no_ray: u64,
+}
+
+/// How far a render got.
+#[derive(Debug)]
+pub struct RenderOutcome {
+    /// The accumulated film: complete passes only.
+    pub film: Film,
+    /// Passes (samples per pixel) in the film.
+    pub passes_done: u32,
+    /// Counters.
+    pub stats: RenderStats,
+    /// Wall-clock time of this call.
+    pub elapsed: Duration,
+}
+
+impl RenderOutcome {
+    /// True when the film holds every sample the scene asks for.
+    pub fn is_complete(&self, scene: &RenderScene) -> bool {
+        self.passes_done >= scene.sampler.samples_per_pixel()
+    }
+}
+
+/// Options of [`render`].
+pub struct RenderOptions<'a> {
+    /// Worker threads; `None` for rayon's default (one per core).
+    pub threads: Option<usize>,
+    /// Set to stop at the next pass boundary (the pass under way is discarded).
+    pub cancel: Option<&'a AtomicBool>,
+    /// Called after each pass with (passes done, passes in all).
+    pub on_pass: Option<&'a (dyn Fn(u32, u32, &Film) + Sync)>,
+    /// Called as tiles finish with (tiles done in this render, tiles in all).
+    pub on_tile: Option<&'a (dyn Fn(u64, u64) + Sync)>,
+    /// Continue from this film, which holds this many passes.
+    pub resume: Option<(Film, u32)>,
+}
+
+impl Default for RenderOptions<'_> {
+    fn default() -> Self {
+        Self {
+            threads: None,
+            cancel: None,
+            on_pass: None,
+            on_tile: None,
+            resume: None,
+        }
+    }
+}
+
+/// The tiles covering `bounds`, row by row.
+pub fn tiles(bounds: PixelRect) -> Vec<PixelRect> {
+    let mut out = Vec::new();
+    let mut y = bounds.y0;
+    while y < bounds.y1 {
+        let mut x = bounds.x0;
+        while x < bounds.x1 {
+            out.push(PixelRect {
+                x0: x,
+                y0: y,
+                x1: (x + TILE_SIZE).min(bounds.x1),
+                y1: (y + TILE_SIZE).min(bounds.y1),
+            });
+            x += TILE_SIZE;
+        }
+        y += TILE_SIZE;
+    }
+    out
+}
+
+/// Renders `scene`, or continues a resumed film, until every pass is done or `cancel` is set.
+pub fn render(
+    scene: &RenderScene,
+    options: RenderOptions<'_>,
+) -> Result<RenderOutcome, rayon::ThreadPoolBuildError> {
+    let mut builder = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = options.threads {
+        builder = builder.num_threads(n.max(1));
+    }
+    let pool = builder.build()?;
+    let start = Instant::now();
+    let spp = scene.sampler.samples_per_pixel();
+    let (mut film, first_pass) = options
+        .resume
+        .unwrap_or_else(|| (Film::new(scene.pixel_bounds), 0));
+    let tiles = tiles(scene.pixel_bounds);
+    let total_tiles = tiles.len() as u64 * u64::from(spp.saturating_sub(first_pass));
+    let tiles_done = AtomicU64::new(0);
+    let samples = AtomicU64::new(0);
+    let dropped = AtomicU64::new(0);
+    let no_ray = AtomicU64::new(0);
+    let cancelled = || options.cancel.is_some_and(|c| c.load(Ordering::Relaxed));
+    let mut passes_done = first_pass;
+    let path = PathIntegrator::new(scene.description.integrator.max_depth);
+
+    pool.install(|| {
+        'passes: for pass in first_pass..spp {
+            let mut pass_film = film.clone();
+            for batch in tiles.chunks(TILES_PER_BATCH) {
+                let buffers: Vec<Option<TileBuffer>> = batch
+                    .par_iter()
+                    .map(|&tile| {
+                        if cancelled() {
+                            return None;
+                        }
+                        let mut buffer = TileBuffer::new(tile, scene.pixel_bounds, scene.filter);
+                        let counts = render_tile(scene, &path, tile, pass, &mut buffer);
+                        samples.fetch_add(counts.samples, Ordering::Relaxed);
+                        dropped.fetch_add(counts.dropped_nonfinite, Ordering::Relaxed);
+                        no_ray.fetch_add(counts.no_ray, Ordering::Relaxed);
+                        let done = tiles_done.fetch_add(1, Ordering::Relaxed) + 1;
+                        if let Some(f) = options.on_tile {
+                            f(done, total_tiles);
+                        }
+                        Some(buffer)
+                    })
+                    .collect();
+                if buffers.iter().any(Option::is_none) {
+                    break 'passes;
+                }
+                for b in buffers.iter().flatten() {
+                    pass_film.merge(b);
+                }
+            }
+            film = pass_film;
+            passes_done = pass + 1;
+            if let Some(f) = options.on_pass {
+                f(passes_done, spp, &film);
+            }
+            if cancelled() {
+                break;
+            }
+        }
+    });
+    Ok(RenderOutcome {
+        film,
+        passes_done,
+        stats: RenderStats {
+            samples: samples.into_inner(),
+            dropped_nonfinite: dropped.into_inner(),
+            no_ray: no_ray.into_inner(),
+        },
+        elapsed: start.elapsed(),
+    })
+}
+
+/// Takes sample `index` of every pixel of `tile`.
+fn render_tile(
+    scene: &RenderScene,
+    path: &PathIntegrator,
+    tile: PixelRect,
+    index: u32,
+    buffer: &mut TileBuffer,
+) -> RenderStats {
+    let mut stats = RenderStats::default();
+    for y in tile.y0..tile.y1 {
+        for x in tile.x0..tile.x1 {
+            stats.samples += 1;
+            let mut stream = scene.sampler.stream([x, y], index);
+            let dims = stream.camera();
+            let p_film = Vec2::new(x as f32, y as f32) + dims.film;
+            let sample = CameraSample {
+                p_film: Point2::from_glam(p_film),
+                p_lens: dims.lens,
+                time: dims.time,
+            };
+            let Some(camera_ray) = scene.camera.generate_ray(&sample) else {
+                // No ray: the sample sees nothing, but still counts in the pixel's mean.
+                stats.no_ray += 1;
+                buffer.add_sample(p_film, Vec3::ZERO, false);
+                continue;
+            };
+            let (value, hit) = sample_value(scene, path, &camera_ray.ray, &mut stream);
+            let value = value * camera_ray.weight;
+            if !value.is_finite() {
+                stats.dropped_nonfinite += 1;
+                continue;
+            }
+            buffer.add_sample(p_film, value, hit);
+        }
+    }
+    stats
+}
+
+/// The integrator's value for one camera ray, and whether the ray hit geometry.
+pub fn sample_value(
+    scene: &RenderScene,
+    path: &PathIntegrator,
+    ray: &Ray<World>,
+    stream: &mut SampleStream<'_>,
+) -> (Vec3, bool) {
+    let kind = scene.integrator();
+    if kind == IntegratorKind::Path {
+        // Coverage needs to know whether the camera ray hit; the path tracer intersects again.
+        let hit = scene.geometry.intersect(ray).is_some();
+        return (path.li(&scene.geometry, &scene.shading, ray, stream), hit);
+    }
+    let Some(hit) = scene.geometry.intersect(ray) else {
+        return (Vec3::ZERO, false);
+    };
+    let value = match kind {
+        IntegratorKind::Depth => {
+            let camera_from_world = scene.camera.world_from_camera().at(ray.time).inverse();
+            Vec3::splat((camera_from_world * hit.p).z)
+        }
+        IntegratorKind::Distance => Vec3::splat(hit.p.distance(ray.origin)),
+        IntegratorKind::Position => hit.p.to_glam(),
+        IntegratorKind::Normal => hit.n_shading.face_forward(-ray.direction).to_glam(),
+        IntegratorKind::Albedo => scene
+            .shading
+            .material(hit.instance)
+            .map_or(Vec3::ZERO, |m| m.albedo()),
+        IntegratorKind::Path => unreachable!("handled above"),
+    };
+    (value, true)
+}
