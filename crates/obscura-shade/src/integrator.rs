@@ -381,38 +381,17 @@ fn shading_frame(hit: &Hit, material: &Material, wo_world: Vec3) -> Frame {
     Frame::from_normal(n_shading.try_normalize().unwrap_or(Vec3::Z))
 }
 
-/// The offset used when the accelerator's error bound along the normal is exactly zero (a
-/// surface lying on a coordinate plane, e.g. a floor at `y = 0`): a few ulps of the point's
-/// largest coordinate, so the spawned ray cannot re-hit its own surface at `t = 0`.
-fn fallback_offset(hit: &Hit, w: Vec3) -> Option<Vec3> {
-    let p = hit.p.to_glam();
-    let n = hit.n_geometric.to_glam();
-    if n.abs().dot(hit.p_error.to_glam().abs()) > 0.0 {
-        return None;
-    }
-    let d = 1e-6 * (1.0 + p.abs().max_element());
-    Some(if w.dot(n) < 0.0 { p - n * d } else { p + n * d })
-}
-
 /// A ray leaving `hit` along `direction` at the hit's time (the path's own time).
 fn spawn_ray(hit: &Hit, direction: Vec3) -> Ray<World> {
     let mut ray = hit.spawn_ray(Vector3::from_glam(direction));
-    if let Some(origin) = fallback_offset(hit, direction) {
-        ray.origin = obscura_space::Point3::from_glam(origin);
-    }
     ray.time = hit.time;
     ray
 }
 
-/// A shadow ray from `hit` to `target`, stopping just short of it, at the hit's time.
+/// A shadow ray from `hit` to just short of `target`, at the hit's time, so that moving
+/// occluders are where they are at that instant.
 fn spawn_ray_to(hit: &Hit, target: Vec3) -> Ray<World> {
-    let target_point = obscura_space::Point3::from_glam(target);
-    let mut ray = hit.spawn_ray_to(target_point);
-    if let Some(origin) = fallback_offset(hit, target - hit.p.to_glam()) {
-        let origin = obscura_space::Point3::from_glam(origin);
-        ray = Ray::new(origin, target_point - origin, hit.time)
-            .with_range(0.0, 1.0 - obscura_accel::SHADOW_EPSILON);
-    }
+    let mut ray = hit.spawn_ray_to(obscura_space::Point3::from_glam(target));
     ray.time = hit.time;
     ray
 }
