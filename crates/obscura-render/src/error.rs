@@ -46,16 +46,20 @@ pub enum RenderError {
 }
 
 impl RenderError {
-    /// A scene error without a known line.
+    /// A scene error about `key`; its line is looked up in the file (if it can be read).
     pub fn scene(
         file: impl Into<PathBuf>,
         key: impl Into<String>,
         message: impl Into<String>,
     ) -> Self {
+        let (file, key) = (file.into(), key.into());
+        let line = std::fs::read_to_string(&file)
+            .ok()
+            .and_then(|source| crate::locate::line_of_key(&source, &key));
         RenderError::Scene {
-            file: file.into(),
-            line: None,
-            key: Some(key.into()),
+            file,
+            line,
+            key: Some(key),
             message: message.into(),
         }
     }

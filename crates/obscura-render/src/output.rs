@@ -90,19 +90,28 @@ fn write_exr(tmp: &Path, image: &Image, info: &ImageInfo) -> Result<(), RenderEr
         let p = image.pixels[pos.y() * w + pos.x()];
         (p[0], p[1], p[2], p[3])
     });
-    let mut attributes = LayerAttributes::default();
-    attributes.software_name = Some(Text::from("obscura"));
+    let mut attributes = LayerAttributes {
+        software_name: Some(Text::from("obscura")),
+        ..LayerAttributes::default()
+    };
     attributes.other.insert(
         Text::from("obscuraPartial"),
         AttributeValue::I32(i32::from(info.partial)),
     );
-    attributes.other.insert(
-        Text::from("obscuraSamplesPerPixel"),
-        AttributeValue::I32(info.samples_per_pixel.min(i32::MAX as u32) as i32),
+    // One custom attribute only: `other` is a hash map, so two entries would be written in a
+    // different order on every run. The sample count goes into the standard comments.
+    let comment = format!(
+        "obscura: {} samples per pixel{}",
+        info.samples_per_pixel,
+        if info.partial { " (partial)" } else { "" }
     );
+    attributes.comments = Some(Text::from(comment.as_str()));
     let layer = Layer::new((w, h), attributes, Encoding::FAST_LOSSLESS, channels);
+    // Compressed in order on this thread: parallel encoding writes blocks in the order they
+    // finish, and the same image must give the same bytes every time.
     Image::from_layer(layer)
         .write()
+        .non_parallel()
         .to_file(tmp)
         .map_err(|e| RenderError::Encode {
             file: tmp.to_path_buf(),

@@ -55,30 +55,22 @@ impl RenderOutcome {
     }
 }
 
+/// Called after each pass with (passes done, passes in all, the film so far).
+pub type PassCallback = dyn Fn(u32, u32, &Film) + Sync;
+
 /// Options of [`render`].
+#[derive(Default)]
 pub struct RenderOptions<'a> {
     /// Worker threads; `None` for rayon's default (one per core).
     pub threads: Option<usize>,
     /// Set to stop at the next pass boundary (the pass under way is discarded).
     pub cancel: Option<&'a AtomicBool>,
     /// Called after each pass with (passes done, passes in all).
-    pub on_pass: Option<&'a (dyn Fn(u32, u32, &Film) + Sync)>,
+    pub on_pass: Option<&'a PassCallback>,
     /// Called as tiles finish with (tiles done in this render, tiles in all).
     pub on_tile: Option<&'a (dyn Fn(u64, u64) + Sync)>,
     /// Continue from this film, which holds this many passes.
     pub resume: Option<(Film, u32)>,
-}
-
-impl Default for RenderOptions<'_> {
-    fn default() -> Self {
-        Self {
-            threads: None,
-            cancel: None,
-            on_pass: None,
-            on_tile: None,
-            resume: None,
-        }
-    }
 }
 
 /// The tiles covering `bounds`, row by row.
@@ -224,9 +216,7 @@ pub fn sample_value(
 ) -> (Vec3, bool) {
     let kind = scene.integrator();
     if kind == IntegratorKind::Path {
-        // Coverage needs to know whether the camera ray hit; the path tracer intersects again.
-        let hit = scene.geometry.intersect(ray).is_some();
-        return (path.li(&scene.geometry, &scene.shading, ray, stream), hit);
+        return path.li_and_hit(&scene.geometry, &scene.shading, ray, stream);
     }
     let Some(hit) = scene.geometry.intersect(ray) else {
         return (Vec3::ZERO, false);

@@ -948,7 +948,7 @@ impl Cx<'_> {
                 let edge_u = need("edge_u", s.edge_u)?;
                 let edge_v = need("edge_v", s.edge_v)?;
                 let n = glam::Vec3::from(edge_u).cross(glam::Vec3::from(edge_v));
-                if !(n.length() > 0.0) {
+                if n.length() <= 0.0 || n.is_nan() {
                     return Err(self.err(
                         &key("edge_v"),
                         "edge_u and edge_v are parallel or zero: the quad has no area",

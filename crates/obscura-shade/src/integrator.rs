@@ -200,8 +200,20 @@ impl PathIntegrator {
         ray: &Ray<World>,
         dims: &mut impl SampleDims,
     ) -> Vec3 {
-        let l = self.trace(geometry, shading, ray, dims);
-        if l.is_finite() { l } else { Vec3::ZERO }
+        self.li_and_hit(geometry, shading, ray, dims).0
+    }
+
+    /// [`PathIntegrator::li`], and whether `ray` itself hit geometry (the film's coverage), at
+    /// the cost of one path.
+    pub fn li_and_hit(
+        &self,
+        geometry: &Scene,
+        shading: &ShadingScene,
+        ray: &Ray<World>,
+        dims: &mut impl SampleDims,
+    ) -> (Vec3, bool) {
+        let (l, hit) = self.trace(geometry, shading, ray, dims);
+        (if l.is_finite() { l } else { Vec3::ZERO }, hit)
     }
 
     fn trace(
@@ -210,12 +222,13 @@ impl PathIntegrator {
         shading: &ShadingScene,
         camera_ray: &Ray<World>,
         dims: &mut impl SampleDims,
-    ) -> Vec3 {
+    ) -> (Vec3, bool) {
+        let mut camera_ray_hit = false;
         let mut radiance = Vec3::ZERO;
         let mut beta = Vec3::ONE;
         let mut ray = *camera_ray;
         let Some(dir) = ray.direction.to_glam().try_normalize() else {
-            return Vec3::ZERO;
+            return (Vec3::ZERO, false);
         };
         ray.direction = Vector3::from_glam(dir);
         // The previous scattering: was it a delta lobe, its pdf, and where it happened.
@@ -243,6 +256,7 @@ impl PathIntegrator {
                 }
                 break;
             };
+            camera_ray_hit |= depth == 0;
             let wo_world = -d_world;
             let n_geometric = hit.n_geometric.to_glam();
 
@@ -322,7 +336,7 @@ impl PathIntegrator {
                 beta /= survive;
             }
         }
-        radiance
+        (radiance, camera_ray_hit)
     }
 
     /// One light sample at `hit`, MIS-weighted against BSDF sampling, unoccluded or zero.
