@@ -1,4 +1,48 @@
-//! obscura-render: scene files, film, integrators and image output (under construction).
+//! The Obscura renderer: scene files, the film, the integrators, the parallel tile scheduler and
+//! image output. It composes the other crates and is the only one that knows the scene format.
+//!
+//! - [`load_description`] / [`parse_description`] read a TOML scene file strictly into a
+//!   [`SceneDescription`] (unknown keys, NaNs and out-of-range values are [`RenderError`]s that
+//!   name the file, the key and the line);
+//! - [`RenderScene::build`] turns it into a camera (`obscura-camera`), geometry
+//!   (`obscura-accel`), materials and lights (`obscura-shade`) and a sampler;
+//! - [`render`] takes the samples in passes of one per pixel over 16x16 tiles, in parallel,
+//!   splatting each into a [`Film`] through its reconstruction [`Filter`];
+//! - [`write_image`] writes EXR or PNG atomically.
+//!
+//! The decision to know: tiles accumulate into their own buffers, merged into the film in tile
+//! order after each batch, and a render is a fixed sequence of passes. So the image is
+//! bit-identical for any thread count and any tile completion order.
+//!
+//! Not for: camera models, BVHs or BSDFs themselves (their crates), nor the command line (the
+//! `camera-obscura` package's `obscura` binary).
+//!
+//! ```
+//! use obscura_render::{parse_description, render, RenderOptions, RenderScene};
+//!
+//! let toml = r#"
+//!     [film]
+//!     resolution = [16, 16]
+//!     [integrator]
+//!     type = "distance"
+//!     [camera]
+//!     eye = [0.0, 0.0, 3.0]
+//!     target = [0.0, 0.0, 0.0]
+//!     fov = 30.0
+//!     [[shapes]]
+//!     type = "quad"
+//!     origin = [-10.0, -10.0, 0.0]
+//!     edge_u = [20.0, 0.0, 0.0]
+//!     edge_v = [0.0, 20.0, 0.0]
+//! "#;
+//! let scene = RenderScene::build(parse_description("inline.toml".as_ref(), toml)?)?;
+//! let outcome = render(&scene, RenderOptions { threads: Some(1), ..Default::default() })?;
+//! let image = outcome.film.resolve();
+//! // The wall fills the view 3 units away; at the centre the distance is 3 (alpha 1: covered).
+//! let [d, _, _, alpha] = image.pixel(8, 8);
+//! assert!((d - 3.0).abs() < 0.01 && alpha == 1.0);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 #![deny(missing_docs)]
 
 mod build;
