@@ -46,17 +46,24 @@
 #![deny(missing_docs)]
 
 mod build;
+mod checkpoint;
 mod error;
 mod film;
 mod locate;
 mod output;
+mod postprocess;
 mod render;
 mod scene;
 
 pub use build::{BYTES_PER_PIXEL, DEFAULT_MATERIAL, RenderScene, human_bytes};
+pub use checkpoint::{CHECKPOINT_MAGIC, CHECKPOINT_VERSION, Checkpoint, scene_fingerprint};
 pub use error::RenderError;
 pub use film::{Film, Filter, Image, PixelRect, PixelSums, TileBuffer};
 pub use output::{ImageInfo, OutputFormat, read_exr, srgb_8bit, temporary_beside, write_image};
+pub use postprocess::{
+    DepthOfField, ScreenBuffers, circle_of_confusion, circle_of_confusion_orthographic,
+    depth_of_field, motion_blur, screen_buffers,
+};
 pub use render::{
     RenderOptions, RenderOutcome, RenderStats, TILE_SIZE, render, sample_value, tiles,
 };

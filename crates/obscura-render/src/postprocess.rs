@@ -1,0 +1,568 @@
+//! Depth of field and motion blur as image post-processes (Potmesil and Chakravarty, 1981-83):
+//! the approximation that Cook, Porter and Carpenter's distributed ray tracing replaced. It is
+//! here so that the two can be compared on the same scene (the gallery does), not as a
+//! recommended way to render.
+//!
+//! The inputs are a sharp pinhole image at shutter open and, per pixel, what the pixel-centre
+//! ray sees: its camera-space depth and its screen-space velocity ([`screen_buffers`]). Both
+//! blurs *scatter*: each source pixel spreads its colour over the pixels it would have reached
+//! (a disc for defocus, a segment for motion), and each output pixel is the weighted mean of
+//! what reached it. Known artefacts, all because one visible surface per pixel is all there is:
+//!
+//! - surfaces hidden behind a blurred foreground are never revealed (the true defocused edge is
+//!   partly see-through; here it is an opaque smear of the foreground colour mixed with the
+//!   colour in front of which it sits);
+//! - a blurred background spreads over a sharp, in-focus foreground's edge (there is no depth
+//!   test on the scatter), so a sharp object gets a halo of background colour;
+//! - shadows, reflections and refractions of a moving object do not move: their pixels see a
+//!   static floor or mirror, whose velocity is zero;
+//! - where a moving object was at shutter open, the background it uncovers is unknown, so the
+//!   object's colour stays at full strength there.
+
+use crate::RenderScene;
+use crate::error::RenderError;
+use crate::film::Image;
+use glam::Vec2;
+use obscura_camera::{AnyCamera, Camera, CameraSample};
+use obscura_space::{Camera as CameraSpace, Point2, Point3, Raster};
+
+/// How a depth maps to a circle of confusion: the projection, the lens and the film scale.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DepthOfField {
+    /// The camera-space depth `f` of the plane in focus (> 0).
+    pub focal_distance: f32,
+    /// The lens radius `r` in world units (>= 0).
+    pub lens_radius: f32,
+    /// Raster pixels per camera-space unit on the plane `z = 1` (perspective) or on any plane
+    /// (orthographic). For a perspective camera this is `s * width / (x_max - x_min)` with `s`
+    /// the fov scale and `[x_min, x_max]` the screen window.
+    pub pixels_per_unit: f32,
+    /// Whether the camera is orthographic (its image scale does not depend on depth).
+    pub orthographic: bool,
+}
+
+impl DepthOfField {
+    /// The parameters of a projective camera's own lens and film. Errors: an environment camera
+    /// (it has no thin lens).
+    pub fn for_camera(camera: &AnyCamera) -> Result<DepthOfField, RenderError> {
+        let (projective, orthographic) = match camera {
+            AnyCamera::Perspective(c) => (c.projective(), false),
+            AnyCamera::Orthographic(c) => (c.projective(), true),
+            AnyCamera::Environment(_) => {
+                return Err(RenderError::Setting {
+                    name: "camera",
+                    message: "depth of field post-processing needs a perspective or \
+                              orthographic camera"
+                        .into(),
+                });
+            }
+        };
+        // Measure the raster scale on the plane z = 1: the image of a unit step in camera x.
+        let raster_from_camera = projective.raster_from_camera();
+        let p0 = raster_from_camera.point(Point3::<CameraSpace>::new(0.0, 0.0, 1.0));
+        let p1 = raster_from_camera.point(Point3::<CameraSpace>::new(1.0, 0.0, 1.0));
+        let lens = projective.lens();
+        let params = DepthOfField {
+            focal_distance: lens.focal_distance,
+            lens_radius: lens.radius,
+            pixels_per_unit: (p1.x - p0.x).abs(),
+            orthographic,
+        };
+        params.validate()?;
+        Ok(params)
+    }
+
+    /// Checks every parameter: `focal_distance > 0`, `lens_radius >= 0`, `pixels_per_unit > 0`,
+    /// all finite.
+    pub fn validate(&self) -> Result<(), RenderError> {
+        let bad = |name: &'static str, what: &str, got: f32| {
+            Err(RenderError::Setting {
+                name,
+                message: format!("must be {what}, got {got}"),
+            })
+        };
+        if !(self.focal_distance > 0.0 && self.focal_distance.is_finite()) {
+            return bad("focal_distance", "finite and > 0", self.focal_distance);
+        }
+        if !(self.lens_radius >= 0.0 && self.lens_radius.is_finite()) {
+            return bad("lens_radius", "finite and >= 0", self.lens_radius);
+        }
+        if !(self.pixels_per_unit > 0.0 && self.pixels_per_unit.is_finite()) {
+            return bad("pixels_per_unit", "finite and > 0", self.pixels_per_unit);
+        }
+        Ok(())
+    }
+
+    /// The circle of confusion, in raster pixels, of a point at camera-space depth `depth`
+    /// (`f32::INFINITY` for the sky). Errors: invalid parameters or a depth that is not > 0.
+    pub fn radius(&self, depth: f32) -> Result<f32, RenderError> {
+        if self.orthographic {
+            circle_of_confusion_orthographic(
+                depth,
+                self.focal_distance,
+                self.lens_radius,
+                self.pixels_per_unit,
+            )
+        } else {
+            circle_of_confusion(
+                depth,
+                self.focal_distance,
+                self.lens_radius,
+                self.pixels_per_unit,
+            )
+        }
+    }
+}
+
+fn check_depth(depth: f32) -> Result<(), RenderError> {
+    // NaN and non-positive depths are errors; +infinity (the sky) is allowed.
+    if depth.is_nan() || depth <= 0.0 {
+        return Err(RenderError::Setting {
+            name: "depth",
+            message: format!("must be > 0, got {depth}"),
+        });
+    }
+    Ok(())
+}
+
+/// The radius, in raster pixels, of the disc that a point at camera-space depth `depth` spreads
+/// into through a perspective camera's thin lens: `r |1/z - 1/f| k`.
+///
+/// Derivation, with Obscura's thin lens (a lens point `L` on the plane `z = 0`, the film point's
+/// pinhole ray through the lens centre meeting the focal plane `z = f` at `a f`, where `a` is the
+/// film point's position on the plane `z = 1`): the sample ray `L + (a f - L) z / f` reaches the
+/// point `P` at depth `z` when `a = P / z - L (1/z - 1/f)`. So as `L` covers the disc of radius
+/// `r`, the film positions that see `P` cover a disc of radius `r |1/z - 1/f|` on the plane
+/// `z = 1`, centred on the pinhole image `P / z`; `k` (`pixels_per_unit_at_z1`) turns that into
+/// raster pixels. Zero at `z = f`, `r k / f` for the sky (`z = infinity`).
+///
+/// Errors (never NaN): `depth` not > 0, `focal_distance` not finite and > 0, `lens_radius` not
+/// finite and >= 0, `pixels_per_unit_at_z1` not finite and > 0.
+pub fn circle_of_confusion(
+    depth: f32,
+    focal_distance: f32,
+    lens_radius: f32,
+    pixels_per_unit_at_z1: f32,
+) -> Result<f32, RenderError> {
+    DepthOfField {
+        focal_distance,
+        lens_radius,
+        pixels_per_unit: pixels_per_unit_at_z1,
+        orthographic: false,
+    }
+    .validate()?;
+    check_depth(depth)?;
+    Ok(lens_radius * (1.0 / depth - 1.0 / focal_distance).abs() * pixels_per_unit_at_z1)
+}
+
+/// The same for an orthographic camera's thin lens: `r |1 - z/f| k`, with `k` raster pixels
+/// per world unit. (The pinhole ray is parallel to +z, so `a = P - L (1 - z/f)`.) Errors as for
+/// [`circle_of_confusion`].
+pub fn circle_of_confusion_orthographic(
+    depth: f32,
+    focal_distance: f32,
+    lens_radius: f32,
+    pixels_per_unit: f32,
+) -> Result<f32, RenderError> {
+    DepthOfField {
+        focal_distance,
+        lens_radius,
+        pixels_per_unit,
+        orthographic: true,
+    }
+    .validate()?;
+    check_depth(depth)?;
+    if depth.is_infinite() {
+        return Err(RenderError::Setting {
+            name: "depth",
+            message: "an orthographic lens blurs infinitely far points without bound".into(),
+        });
+    }
+    Ok(lens_radius * (1.0 - depth / focal_distance).abs() * pixels_per_unit)
+}
+
+fn check_buffer(image: &Image, len: usize, name: &'static str) -> Result<(), RenderError> {
+    let want = image.width as usize * image.height as usize;
+    if image.pixels.len() != want || len != want {
+        return Err(RenderError::Setting {
+            name,
+            message: format!(
+                "needs one value per pixel of the {}x{} image, got {} (image has {})",
+                image.width,
+                image.height,
+                len,
+                image.pixels.len()
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// Accumulates weighted colours and divides by the total weight at the end.
+struct Splat {
+    width: u32,
+    height: u32,
+    sums: Vec<[f32; 5]>,
+}
+
+impl Splat {
+    fn new(width: u32, height: u32) -> Self {
+        Splat {
+            width,
+            height,
+            sums: vec![[0.0; 5]; width as usize * height as usize],
+        }
+    }
+    #[inline]
+    fn add(&mut self, x: i64, y: i64, c: [f32; 4], w: f32) {
+        if x < 0 || y < 0 || x >= i64::from(self.width) || y >= i64::from(self.height) || w <= 0.0 {
+            return;
+        }
+        let s = &mut self.sums[y as usize * self.width as usize + x as usize];
+        for k in 0..4 {
+            s[k] += c[k] * w;
+        }
+        s[4] += w;
+    }
+    fn finish(self, fallback: &Image) -> Image {
+        let pixels = self
+            .sums
+            .iter()
+            .zip(&fallback.pixels)
+            .map(|(s, &f)| {
+                if s[4] > 0.0 {
+                    [s[0] / s[4], s[1] / s[4], s[2] / s[4], s[3] / s[4]]
+                } else {
+                    f
+                }
+            })
+            .collect();
+        Image {
+            width: self.width,
+            height: self.height,
+            pixels,
+        }
+    }
+}
+
+/// Post-process depth of field: every pixel of the sharp `image` is scattered as a uniform disc
+/// of radius [`DepthOfField::radius`] of its `depth` (camera-space z of what the pixel-centre
+/// ray sees, `f32::INFINITY` where it sees nothing), with an anti-aliased one-pixel rim. Each
+/// disc carries total weight 1 (energy normalisation: a large disc is dimmer per pixel), and
+/// each output pixel is the weighted mean of the discs that cover it. All four channels are
+/// blurred alike (alpha is coverage).
+///
+/// Scatter, not gather, so a blurred foreground does spread over its surroundings; its known
+/// artefacts, since each pixel keeps one visible surface: nothing hidden is revealed, and a blurred background
+/// bleeds over a sharp foreground. Cost: the sum of the discs' areas.
+///
+/// Errors: `depth` not one value per pixel, a depth that is not > 0 (NaN included), invalid
+/// parameters.
+pub fn depth_of_field(
+    image: &Image,
+    depth: &[f32],
+    params: &DepthOfField,
+) -> Result<Image, RenderError> {
+    check_buffer(image, depth.len(), "depth")?;
+    params.validate()?;
+    let mut splat = Splat::new(image.width, image.height);
+    for (i, (&c, &z)) in image.pixels.iter().zip(depth).enumerate() {
+        let (x, y) = (
+            (i % image.width as usize) as i64,
+            (i / image.width as usize) as i64,
+        );
+        // A disc never smaller than the pixel itself, never larger than the image.
+        let radius = params
+            .radius(z)?
+            .clamp(0.5, (image.width.max(image.height)) as f32);
+        // Pixel weights: 1 inside radius - 0.5, falling linearly to 0 at radius + 0.5.
+        let reach = (radius + 0.5).ceil() as i64;
+        let mut total = 0.0;
+        for dy in -reach..=reach {
+            for dx in -reach..=reach {
+                let d = ((dx * dx + dy * dy) as f32).sqrt();
+                total += (radius + 0.5 - d).clamp(0.0, 1.0);
+            }
+        }
+        for dy in -reach..=reach {
+            for dx in -reach..=reach {
+                let d = ((dx * dx + dy * dy) as f32).sqrt();
+                let w = (radius + 0.5 - d).clamp(0.0, 1.0) / total;
+                splat.add(x + dx, y + dy, c, w);
+            }
+        }
+    }
+    Ok(splat.finish(image))
+}
+
+/// Post-process motion blur: every pixel of the sharp `image` (taken at shutter open) is
+/// scattered along the segment from its centre to its centre plus its screen-space `velocity`
+/// (raster pixels moved over the shutter interval): a line integral sampled at least twice per
+/// pixel of length, each sample splatted bilinearly, the segment's total weight 1. Each output
+/// pixel is the weighted mean of what reached it, so a pixel with zero velocity keeps weight 1
+/// of itself and mixes with whatever moving pixels cross it.
+///
+/// Known artefacts, since each pixel keeps one visible surface: shadows and reflections of a moving object
+/// stay sharp (their pixels do not move), and where the object started nothing behind it is
+/// uncovered.
+///
+/// Errors: `velocity` not one value per pixel, or a velocity that is not finite.
+pub fn motion_blur(image: &Image, velocity: &[Vec2]) -> Result<Image, RenderError> {
+    check_buffer(image, velocity.len(), "velocity")?;
+    if let Some(v) = velocity.iter().find(|v| !v.is_finite()) {
+        return Err(RenderError::Setting {
+            name: "velocity",
+            message: format!("must be finite, got ({}, {})", v.x, v.y),
+        });
+    }
+    let mut splat = Splat::new(image.width, image.height);
+    let limit = (image.width + image.height) as f32;
+    for (i, (&c, &v)) in image.pixels.iter().zip(velocity).enumerate() {
+        let p = Vec2::new(
+            (i % image.width as usize) as f32,
+            (i / image.width as usize) as f32,
+        );
+        // Clamp absurd velocities to the image's size: they would only cost time.
+        let v = v.clamp_length_max(limit);
+        let n = (2.0 * v.length()).ceil().max(1.0) as usize;
+        let w = 1.0 / n as f32;
+        for k in 0..n {
+            // Midpoints of n equal parts of the segment [p, p + v].
+            let q = p + v * ((k as f32 + 0.5) / n as f32);
+            let (x0, y0) = (q.x.floor(), q.y.floor());
+            let (fx, fy) = (q.x - x0, q.y - y0);
+            let (x0, y0) = (x0 as i64, y0 as i64);
+            splat.add(x0, y0, c, w * (1.0 - fx) * (1.0 - fy));
+            splat.add(x0 + 1, y0, c, w * fx * (1.0 - fy));
+            splat.add(x0, y0 + 1, c, w * (1.0 - fx) * fy);
+            splat.add(x0 + 1, y0 + 1, c, w * fx * fy);
+        }
+    }
+    Ok(splat.finish(image))
+}
+
+/// What the pixel-centre rays of a scene see at shutter open, for the post-processes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ScreenBuffers {
+    /// Width of the film's pixel bounds.
+    pub width: u32,
+    /// Height of the film's pixel bounds.
+    pub height: u32,
+    /// Camera-space z (at shutter open) of the first hit, `f32::INFINITY` where there is none.
+    pub depth: Vec<f32>,
+    /// Raster displacement over the shutter of the point each pixel sees: the point is carried by
+    /// its instance's motion, `world_from_object(close) * object_from_world(open) * p`, and
+    /// projected by the camera at open and at close. Zero where nothing is hit or a projection
+    /// fails.
+    pub velocity: Vec<Vec2>,
+}
+
+/// Casts one ray through each pixel centre of `scene`'s film, through the lens centre at shutter
+/// open, and records the depth and screen-space velocity of what it hits ([`ScreenBuffers`]).
+/// Instance `i` of the geometry is the scene description's `shapes[i]`, whose `transform` and
+/// `transform_end` give its motion.
+pub fn screen_buffers(scene: &RenderScene) -> ScreenBuffers {
+    let camera = &scene.camera;
+    let bounds = scene.pixel_bounds;
+    let shutter = camera.shutter();
+    let camera_from_world = camera.world_from_camera().at(shutter.open).inverse();
+    let (width, height) = (bounds.width(), bounds.height());
+    let mut depth = Vec::with_capacity(width as usize * height as usize);
+    let mut velocity = Vec::with_capacity(depth.capacity());
+    for y in bounds.y0..bounds.y1 {
+        for x in bounds.x0..bounds.x1 {
+            let p_film = Point2::<Raster>::new(x as f32 + 0.5, y as f32 + 0.5);
+            let hit = camera
+                .generate_ray(&CameraSample::at(p_film))
+                .and_then(|r| scene.geometry.intersect(&r.ray));
+            let Some(hit) = hit else {
+                depth.push(f32::INFINITY);
+                velocity.push(Vec2::ZERO);
+                continue;
+            };
+            depth.push(camera_from_world.point(hit.p).z);
+            // Carry the point by its instance's motion from open to close.
+            let p_end = scene
+                .description
+                .shapes
+                .get(hit.instance as usize)
+                .and_then(|s| s.transform_end.map(|end| (s.transform, end)))
+                .map_or(hit.p, |(start, end)| (end * start.inverse()).point(hit.p));
+            let v = match (
+                camera.project(hit.p, shutter.open),
+                camera.project(p_end, shutter.close),
+            ) {
+                (Some(a), Some(b)) => Vec2::new(b.x - a.x, b.y - a.y),
+                _ => Vec2::ZERO,
+            };
+            velocity.push(if v.is_finite() { v } else { Vec2::ZERO });
+        }
+    }
+    ScreenBuffers {
+        width,
+        height,
+        depth,
+        velocity,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn image(width: u32, height: u32, f: impl Fn(u32, u32) -> [f32; 4]) -> Image {
+        let pixels = (0..height)
+            .flat_map(|y| (0..width).map(move |x| (x, y)))
+            .map(|(x, y)| f(x, y))
+            .collect();
+        Image {
+            width,
+            height,
+            pixels,
+        }
+    }
+
+    fn params(focal_distance: f32, lens_radius: f32) -> DepthOfField {
+        DepthOfField {
+            focal_distance,
+            lens_radius,
+            pixels_per_unit: 100.0,
+            orthographic: false,
+        }
+    }
+
+    #[test]
+    fn circle_of_confusion_matches_the_thin_lens_formula() {
+        // r = 0.1, f = 2, z = 4, k = 100: 0.1 * |1/4 - 1/2| * 100 = 0.1 * 0.25 * 100 = 2.5.
+        let c = circle_of_confusion(4.0, 2.0, 0.1, 100.0).unwrap();
+        assert!((c - 2.5).abs() < 1e-6, "{c}");
+        // Nearer than focus, z = 1: 0.1 * |1 - 1/2| * 100 = 5.
+        let c = circle_of_confusion(1.0, 2.0, 0.1, 100.0).unwrap();
+        assert!((c - 5.0).abs() < 1e-6, "{c}");
+        // The sky, z = infinity: 0.1 * 1/2 * 100 = 5.
+        let c = circle_of_confusion(f32::INFINITY, 2.0, 0.1, 100.0).unwrap();
+        assert!((c - 5.0).abs() < 1e-6, "{c}");
+        // Orthographic, z = 3, f = 2: 0.1 * |1 - 3/2| * 100 = 5.
+        let c = circle_of_confusion_orthographic(3.0, 2.0, 0.1, 100.0).unwrap();
+        assert!((c - 5.0).abs() < 1e-5, "{c}");
+    }
+
+    #[test]
+    fn a_point_at_the_focal_distance_has_no_blur() {
+        assert_eq!(circle_of_confusion(2.5, 2.5, 0.3, 320.0).unwrap(), 0.0);
+        assert_eq!(
+            circle_of_confusion_orthographic(2.5, 2.5, 0.3, 320.0).unwrap(),
+            0.0
+        );
+    }
+
+    #[test]
+    fn invalid_inputs_are_errors_not_nan() {
+        assert!(circle_of_confusion(0.0, 1.0, 0.1, 1.0).is_err());
+        assert!(circle_of_confusion(f32::NAN, 1.0, 0.1, 1.0).is_err());
+        assert!(circle_of_confusion(1.0, 0.0, 0.1, 1.0).is_err());
+        assert!(circle_of_confusion(1.0, 1.0, -0.1, 1.0).is_err());
+        assert!(circle_of_confusion(1.0, 1.0, 0.1, f32::INFINITY).is_err());
+        assert!(circle_of_confusion_orthographic(f32::INFINITY, 1.0, 0.1, 1.0).is_err());
+        let img = image(2, 2, |_, _| [1.0; 4]);
+        assert!(depth_of_field(&img, &[1.0; 3], &params(1.0, 0.1)).is_err());
+        assert!(depth_of_field(&img, &[1.0, 1.0, -1.0, 1.0], &params(1.0, 0.1)).is_err());
+        assert!(motion_blur(&img, &[Vec2::ZERO; 5]).is_err());
+        assert!(motion_blur(&img, &[Vec2::ZERO, Vec2::NAN, Vec2::ZERO, Vec2::ZERO]).is_err());
+    }
+
+    #[test]
+    fn the_thin_lens_circle_is_where_the_sample_rays_land() {
+        // Independent of the closed form: trace the lens edge ray L = (r, 0) towards the focal
+        // point of the film position a, and solve for the a whose ray meets P = (0, 0, z).
+        // Ray: L + (a f - L) s / f at depth s; at s = z: x = r + (a f - r) z / f = 0, so
+        // a = r (z - f) / (z f) ... = -r (1/f - 1/z); for r = 0.2, f = 3, z = 6:
+        // a = 0.2 * 3 / 18 = 1/30 in units at z = 1; times k = 90: 3 pixels.
+        let (r, f, z, k) = (0.2_f32, 3.0_f32, 6.0_f32, 90.0_f32);
+        let a = r * (z - f) / (z * f);
+        assert!((a * k - 3.0).abs() < 1e-5);
+        let c = circle_of_confusion(z, f, r, k).unwrap();
+        assert!((c - 3.0).abs() < 1e-5, "{c}");
+    }
+
+    #[test]
+    fn pixels_in_focus_stay_sharp() {
+        // A checkerboard all at the focal distance: every disc is one pixel, the image unchanged.
+        let img = image(8, 6, |x, y| {
+            let v = ((x + y) % 2) as f32;
+            [v, 1.0 - v, 0.5, 1.0]
+        });
+        let out = depth_of_field(&img, &[2.0; 48], &params(2.0, 0.5)).unwrap();
+        for (a, b) in out.pixels.iter().zip(&img.pixels) {
+            for k in 0..4 {
+                assert!((a[k] - b[k]).abs() < 1e-6, "{a:?} vs {b:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn an_out_of_focus_point_spreads_over_its_circle_of_confusion() {
+        // One white pixel at (10, 10) on black, everything at z = 1 with f = 2, r = 0.06,
+        // k = 100: radius 0.06 * 0.5 * 100 = 3 pixels. Every disc has radius 3 and weight 1 and
+        // covers the same relative pixels, so each output pixel's total weight is 1 (away from
+        // the border) and the white disc lands on pixels within about 3.5 pixels of (10, 10).
+        let img = image(21, 21, |x, y| {
+            if (x, y) == (10, 10) {
+                [1.0, 1.0, 1.0, 1.0]
+            } else {
+                [0.0, 0.0, 0.0, 1.0]
+            }
+        });
+        let out = depth_of_field(&img, &[1.0; 21 * 21], &params(2.0, 0.06)).unwrap();
+        let lit: Vec<(i32, i32)> = (0..21)
+            .flat_map(|y| (0..21).map(move |x| (x, y)))
+            .filter(|&(x, y)| out.pixel(x as u32, y as u32)[0] > 1e-6)
+            .map(|(x, y)| (x - 10, y - 10))
+            .collect();
+        assert!(lit.contains(&(3, 0)) && lit.contains(&(0, -3)));
+        assert!(lit.iter().all(|&(dx, dy)| dx * dx + dy * dy <= 12));
+        // Energy is kept: the sum over the image of the white spread is 1 (weights are all 1).
+        let total: f32 = out.pixels.iter().map(|p| p[0]).sum();
+        assert!((total - 1.0).abs() < 1e-4, "{total}");
+    }
+
+    #[test]
+    fn motion_blur_spreads_a_pixel_along_its_velocity() {
+        // A white pixel at (2, 2) moving 4 pixels right on a static black image: its segment
+        // [2, 6] in x is sampled at 8 midpoints 2.25, 2.75, ..., 5.75, each of weight 1/8,
+        // split bilinearly between columns 2..6. The black pixels keep weight 1 of themselves.
+        let img = image(10, 5, |x, y| {
+            if (x, y) == (2, 2) {
+                [1.0; 4]
+            } else {
+                [0.0, 0.0, 0.0, 1.0]
+            }
+        });
+        let mut velocity = vec![Vec2::ZERO; 50];
+        velocity[2 * 10 + 2] = Vec2::new(4.0, 0.0);
+        let out = motion_blur(&img, &velocity).unwrap();
+        // Samples at 2.25 (0.75 to column 2, 0.25 to 3), 2.75 (0.25, 0.75), 3.25 (0.75 to 3,
+        // 0.25 to 4), ..., 5.75 (0.25 to 5, 0.75 to 6), each times 1/8. So column 2 gets 1/8,
+        // columns 3, 4, 5 get 2/8 each and column 6 gets 1/8 of white.
+        // Column 2 had only the white pixel itself: nothing else reaches it, so it stays white
+        // (the uncovered background is unknown: the artefact the module docs name).
+        assert!((out.pixel(2, 2)[0] - 1.0).abs() < 1e-6);
+        // Columns 3, 4, 5 keep their own black with weight 1: (2/8) / (1 + 2/8) = 0.2.
+        for x in 3..6 {
+            let v = out.pixel(x, 2)[0];
+            assert!((v - 0.2).abs() < 1e-6, "x={x}: {v}");
+        }
+        // Column 6: (1/8) / (1 + 1/8) = 1/9.
+        let col6 = out.pixel(6, 2)[0];
+        assert!((col6 - 1.0 / 9.0).abs() < 1e-6, "{col6}");
+        assert_eq!(out.pixel(7, 2)[0], 0.0);
+        assert_eq!(out.pixel(2, 1)[0], 0.0);
+    }
+
+    #[test]
+    fn zero_velocity_leaves_the_image_unchanged() {
+        let img = image(5, 4, |x, y| [x as f32, y as f32, 0.25, 1.0]);
+        let out = motion_blur(&img, &[Vec2::ZERO; 20]).unwrap();
+        assert_eq!(out, img);
+    }
+}
