@@ -36,6 +36,13 @@ pub enum RenderError {
         /// The encoder's message.
         message: String,
     },
+    /// A checkpoint file is corrupt, truncated, or belongs to another render.
+    Checkpoint {
+        /// The checkpoint file.
+        file: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
     /// A render setting from the command line is invalid.
     Setting {
         /// The setting, e.g. `--spp`.
@@ -91,6 +98,9 @@ impl fmt::Display for RenderError {
                 write!(f, "{}: {action}: {source}", file.display())
             }
             RenderError::Encode { file, message } => write!(f, "{}: {message}", file.display()),
+            RenderError::Checkpoint { file, message } => {
+                write!(f, "{}: checkpoint: {message}", file.display())
+            }
             RenderError::Setting { name, message } => write!(f, "{name}: {message}"),
         }
     }

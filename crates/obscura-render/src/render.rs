@@ -55,8 +55,9 @@ impl RenderOutcome {
     }
 }
 
-/// Called after each pass with (passes done, passes in all, the film so far).
-pub type PassCallback = dyn Fn(u32, u32, &Film) + Sync;
+/// Called after each pass with (passes done, passes in all, the film so far). It may borrow
+/// locals of the caller (a checkpoint path, a timer): the lifetime is the options'.
+pub type PassCallback<'a> = dyn Fn(u32, u32, &Film) + Sync + 'a;
 
 /// Options of [`render`].
 #[derive(Default)]
@@ -66,7 +67,7 @@ pub struct RenderOptions<'a> {
     /// Set to stop at the next pass boundary (the pass under way is discarded).
     pub cancel: Option<&'a AtomicBool>,
     /// Called after each pass with (passes done, passes in all).
-    pub on_pass: Option<&'a PassCallback>,
+    pub on_pass: Option<&'a PassCallback<'a>>,
     /// Called as tiles finish with (tiles done in this render, tiles in all).
     pub on_tile: Option<&'a (dyn Fn(u64, u64) + Sync)>,
     /// Continue from this film, which holds this many passes.
