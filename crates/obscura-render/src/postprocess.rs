@@ -16,8 +16,8 @@
 //!   test on the scatter), so a sharp object gets a halo of background colour;
 //! - shadows, reflections and refractions of a moving object do not move: their pixels see a
 //!   static floor or mirror, whose velocity is zero;
-//! - where a moving object was at shutter open, the background it uncovers is unknown, so the
-//!   object's colour stays at full strength there.
+//! - where a moving object was at shutter open, the background it uncovers is unknown and has
+//!   to be guessed from the still pixels around it.
 
 use crate::RenderScene;
 use crate::error::RenderError;
@@ -252,9 +252,9 @@ impl Splat {
 /// each output pixel is the weighted mean of the discs that cover it. All four channels are
 /// blurred alike (alpha is coverage).
 ///
-/// Scatter, not gather, so a blurred foreground does spread over its surroundings; its known
-/// artefacts, since each pixel keeps one visible surface: nothing hidden is revealed, and a blurred background
-/// bleeds over a sharp foreground. Cost: the sum of the discs' areas.
+/// Scatter, not gather, so a blurred foreground does spread over its surroundings. Its known
+/// artefacts, since each pixel keeps one visible surface: nothing hidden is revealed, and a
+/// blurred background bleeds over a sharp foreground. Cost: the sum of the discs' areas.
 ///
 /// Errors: `depth` not one value per pixel, a depth that is not > 0 (NaN included), invalid
 /// parameters.
@@ -295,16 +295,24 @@ pub fn depth_of_field(
     Ok(splat.finish(image))
 }
 
-/// Post-process motion blur: every pixel of the sharp `image` (taken at shutter open) is
-/// scattered along the segment from its centre to its centre plus its screen-space `velocity`
-/// (raster pixels moved over the shutter interval): a line integral sampled at least twice per
-/// pixel of length, each sample splatted bilinearly, the segment's total weight 1. Each output
-/// pixel is the weighted mean of what reached it, so a pixel with zero velocity keeps weight 1
-/// of itself and mixes with whatever moving pixels cross it.
+/// Pixels moving less than this many raster pixels over the shutter count as still.
+const STILL: f32 = 0.5;
+
+/// Post-process motion blur, in two layers like a compositor's. The *moving layer*: every pixel
+/// of the sharp `image` (taken at shutter open) whose screen-space `velocity` (raster pixels
+/// moved over the shutter interval) is at least half a pixel is scattered along the segment from
+/// its centre to its centre plus its velocity: a line integral sampled at least twice per pixel
+/// of length, each sample splatted bilinearly, the segment's total weight 1. The *still layer*:
+/// the other pixels as they are; where a moving pixel was, the background it hides is unknown and
+/// is guessed from the nearest still pixel behind it (along minus its velocity, else ahead).
+/// Each output pixel is the moving layer's sum plus the still layer times the weight the moving
+/// layer left uncovered (`1 - a`, or the moving sum over `a` where `a > 1`).
 ///
-/// Known artefacts, since each pixel keeps one visible surface: shadows and reflections of a moving object
-/// stay sharp (their pixels do not move), and where the object started nothing behind it is
-/// uncovered.
+/// Known artefacts, since each pixel keeps one visible surface: shadows and reflections of a
+/// moving object stay sharp (their pixels see a still floor or mirror), the guessed background
+/// behind a moving object is a stretched copy of its neighbours, and a moving object's own
+/// shading (its highlights, its shadow on itself) moves with it instead of staying with the
+/// light.
 ///
 /// Errors: `velocity` not one value per pixel, or a velocity that is not finite.
 pub fn motion_blur(image: &Image, velocity: &[Vec2]) -> Result<Image, RenderError> {
@@ -315,30 +323,78 @@ pub fn motion_blur(image: &Image, velocity: &[Vec2]) -> Result<Image, RenderErro
             message: format!("must be finite, got ({}, {})", v.x, v.y),
         });
     }
-    let mut splat = Splat::new(image.width, image.height);
+    let (width, height) = (image.width as usize, image.height as usize);
+    let moving = |i: usize| velocity[i].length() >= STILL;
+    let position = |i: usize| Vec2::new((i % width) as f32, (i / width) as f32);
+
+    // The moving layer: each moving pixel spread along its segment with total weight 1.
+    let mut layer = Splat::new(image.width, image.height);
     let limit = (image.width + image.height) as f32;
     for (i, (&c, &v)) in image.pixels.iter().zip(velocity).enumerate() {
-        let p = Vec2::new(
-            (i % image.width as usize) as f32,
-            (i / image.width as usize) as f32,
-        );
+        if !moving(i) {
+            continue;
+        }
         // Clamp absurd velocities to the image's size: they would only cost time.
         let v = v.clamp_length_max(limit);
         let n = (2.0 * v.length()).ceil().max(1.0) as usize;
         let w = 1.0 / n as f32;
+        let p = position(i);
         for k in 0..n {
             // Midpoints of n equal parts of the segment [p, p + v].
             let q = p + v * ((k as f32 + 0.5) / n as f32);
             let (x0, y0) = (q.x.floor(), q.y.floor());
             let (fx, fy) = (q.x - x0, q.y - y0);
             let (x0, y0) = (x0 as i64, y0 as i64);
-            splat.add(x0, y0, c, w * (1.0 - fx) * (1.0 - fy));
-            splat.add(x0 + 1, y0, c, w * fx * (1.0 - fy));
-            splat.add(x0, y0 + 1, c, w * (1.0 - fx) * fy);
-            splat.add(x0 + 1, y0 + 1, c, w * fx * fy);
+            layer.add(x0, y0, c, w * (1.0 - fx) * (1.0 - fy));
+            layer.add(x0 + 1, y0, c, w * fx * (1.0 - fy));
+            layer.add(x0, y0 + 1, c, w * (1.0 - fx) * fy);
+            layer.add(x0 + 1, y0 + 1, c, w * fx * fy);
         }
     }
-    Ok(splat.finish(image))
+
+    // The still layer, with the background behind moving pixels guessed from still neighbours.
+    let still_behind = |i: usize| -> [f32; 4] {
+        let v = velocity[i].clamp_length_max(limit);
+        let steps = (2.0 * v.length()).ceil() as usize + 2;
+        let p = position(i);
+        for direction in [-v.normalize(), v.normalize()] {
+            for k in 1..=steps {
+                let q = (p + direction * k as f32).round();
+                if q.x < 0.0 || q.y < 0.0 || q.x >= width as f32 || q.y >= height as f32 {
+                    break;
+                }
+                let j = q.y as usize * width + q.x as usize;
+                if !moving(j) {
+                    return image.pixels[j];
+                }
+            }
+        }
+        image.pixels[i]
+    };
+
+    // Composite: the moving layer over the still one.
+    let pixels = layer
+        .sums
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            let a = s[4];
+            if a >= 1.0 {
+                return [s[0] / a, s[1] / a, s[2] / a, s[3] / a];
+            }
+            let still = if moving(i) {
+                still_behind(i)
+            } else {
+                image.pixels[i]
+            };
+            std::array::from_fn(|k| s[k] + (1.0 - a) * still[k])
+        })
+        .collect();
+    Ok(Image {
+        width: image.width,
+        height: image.height,
+        pixels,
+    })
 }
 
 /// What the pixel-centre rays of a scene see at shutter open, for the post-processes.
@@ -542,19 +598,26 @@ mod tests {
         velocity[2 * 10 + 2] = Vec2::new(4.0, 0.0);
         let out = motion_blur(&img, &velocity).unwrap();
         // Samples at 2.25 (0.75 to column 2, 0.25 to 3), 2.75 (0.25, 0.75), 3.25 (0.75 to 3,
-        // 0.25 to 4), ..., 5.75 (0.25 to 5, 0.75 to 6), each times 1/8. So column 2 gets 1/8,
-        // columns 3, 4, 5 get 2/8 each and column 6 gets 1/8 of white.
-        // Column 2 had only the white pixel itself: nothing else reaches it, so it stays white
-        // (the uncovered background is unknown: the artefact the module docs name).
-        assert!((out.pixel(2, 2)[0] - 1.0).abs() < 1e-6);
-        // Columns 3, 4, 5 keep their own black with weight 1: (2/8) / (1 + 2/8) = 0.2.
-        for x in 3..6 {
-            let v = out.pixel(x, 2)[0];
-            assert!((v - 0.2).abs() < 1e-6, "x={x}: {v}");
+        // 0.25 to 4), ..., 5.75 (0.25 to 5, 0.75 to 6), each times 1/8. So the moving layer
+        // puts 1/8 of white on column 2, 2/8 on columns 3, 4, 5 and 1/8 on column 6; the still
+        // black layer fills the rest of each pixel's weight (at column 2, the hidden background
+        // is guessed from column 1: black).
+        let expect = [
+            (2, 0.125),
+            (3, 0.25),
+            (4, 0.25),
+            (5, 0.25),
+            (6, 0.125),
+            (7, 0.0),
+        ];
+        for (x, want) in expect {
+            let got = out.pixel(x, 2);
+            assert!((got[0] - want).abs() < 1e-6, "x={x}: {got:?}");
+            assert!(
+                (got[3] - 1.0).abs() < 1e-6,
+                "alpha stays 1 at x={x}: {got:?}"
+            );
         }
-        // Column 6: (1/8) / (1 + 1/8) = 1/9.
-        let col6 = out.pixel(6, 2)[0];
-        assert!((col6 - 1.0 / 9.0).abs() < 1e-6, "{col6}");
         assert_eq!(out.pixel(7, 2)[0], 0.0);
         assert_eq!(out.pixel(2, 1)[0], 0.0);
     }
