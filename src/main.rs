@@ -2,12 +2,19 @@
 
 use clap::{Parser, Subcommand};
 use obscura_render::{
-    ImageInfo, IntegratorKind, OutputFormat, RenderError, RenderOptions, RenderScene,
-    load_description, render, write_image,
+    Checkpoint, Film, ImageInfo, IntegratorKind, OutputFormat, RenderError, RenderOptions,
+    RenderScene, load_description, render, scene_fingerprint, write_image,
 };
+use signal_hook::consts::{SIGINT, SIGTERM};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+/// Exit status after a second interrupt, which quits at once without writing.
+const EXIT_SECOND_SIGNAL: i32 = 130;
 
 /// Obscura: camera models for ray tracing, and a renderer that composes them.
 #[derive(Parser)]
@@ -41,6 +48,15 @@ enum Command {
         /// Image size as WIDTHxHEIGHT (overrides the scene's)
         #[arg(long)]
         resolution: Option<String>,
+        /// Save the film's sums to this file now and then, on interrupt and at the end
+        #[arg(long, value_name = "FILE")]
+        checkpoint: Option<PathBuf>,
+        /// Seconds between checkpoints (0: after every pass)
+        #[arg(long, value_name = "SECONDS", default_value_t = 60.0)]
+        checkpoint_every: f64,
+        /// Continue a render from a checkpoint made with the same scene and flags
+        #[arg(long, value_name = "FILE")]
+        resume: Option<PathBuf>,
     },
     /// Parse and validate a scene, print a summary, render nothing.
     Check {
@@ -60,11 +76,25 @@ fn main() -> ExitCode {
             threads,
             integrator,
             resolution,
-        } => run_render(&scene, output, spp, seed, threads, integrator, resolution),
-        Command::Check { scene } => run_check(&scene),
+            checkpoint,
+            checkpoint_every,
+            resume,
+        } => run_render(RenderArgs {
+            scene_path: scene,
+            output,
+            spp,
+            seed,
+            threads,
+            integrator,
+            resolution,
+            checkpoint,
+            checkpoint_every,
+            resume,
+        }),
+        Command::Check { scene } => run_check(&scene).map(|()| ExitCode::SUCCESS),
     };
     match result {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(code) => code,
         Err(e) => {
             eprintln!("error: {e}");
             ExitCode::from(2)
@@ -79,16 +109,64 @@ fn setting(name: &'static str, message: impl Into<String>) -> RenderError {
     }
 }
 
-fn run_render(
-    scene_path: &Path,
+/// The `render` subcommand's arguments.
+struct RenderArgs {
+    scene_path: PathBuf,
     output: Option<PathBuf>,
     spp: Option<u32>,
     seed: Option<u64>,
     threads: Option<usize>,
     integrator: Option<String>,
     resolution: Option<String>,
-) -> Result<(), RenderError> {
-    let output = output.unwrap_or_else(|| scene_path.with_extension("exr"));
+    checkpoint: Option<PathBuf>,
+    checkpoint_every: f64,
+    resume: Option<PathBuf>,
+}
+
+/// SIGINT and SIGTERM handling: the first sets `cancel` (the render stops at the next pass
+/// boundary and the partial image is written) and records which signal; a second one exits at
+/// once with status 130, writing nothing.
+struct Interrupts {
+    cancel: Arc<AtomicBool>,
+    signal: Arc<AtomicUsize>,
+}
+
+impl Interrupts {
+    fn install() -> Result<Self, RenderError> {
+        let cancel = Arc::new(AtomicBool::new(false));
+        let signal = Arc::new(AtomicUsize::new(0));
+        for sig in [SIGINT, SIGTERM] {
+            // Order matters: the shutdown action runs first and only fires if an earlier
+            // signal already set the flag; then this signal sets it.
+            signal_hook::flag::register_conditional_shutdown(
+                sig,
+                EXIT_SECOND_SIGNAL,
+                Arc::clone(&cancel),
+            )
+            .and_then(|_| signal_hook::flag::register_usize(sig, Arc::clone(&signal), sig as usize))
+            .and_then(|_| signal_hook::flag::register(sig, Arc::clone(&cancel)))
+            .map_err(|e| setting("render", format!("cannot install the signal handlers: {e}")))?;
+        }
+        Ok(Self { cancel, signal })
+    }
+
+    /// The signal that interrupted the render, if one did.
+    fn received(&self) -> Option<i32> {
+        if !self.cancel.load(Ordering::SeqCst) {
+            return None;
+        }
+        match self.signal.load(Ordering::SeqCst) {
+            0 => Some(SIGINT),
+            s => Some(s as i32),
+        }
+    }
+}
+
+fn run_render(args: RenderArgs) -> Result<ExitCode, RenderError> {
+    let scene_path = args.scene_path.as_path();
+    let output = args
+        .output
+        .unwrap_or_else(|| scene_path.with_extension("exr"));
     OutputFormat::from_path(&output)?;
     let folder = match output.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
@@ -104,35 +182,83 @@ fn run_render(
             ),
         ));
     }
+    let threads = args.threads;
     if threads == Some(0) {
         return Err(setting("--threads", "must be >= 1, got 0"));
     }
+    if !(args.checkpoint_every.is_finite() && args.checkpoint_every >= 0.0) {
+        return Err(setting(
+            "--checkpoint-every",
+            format!(
+                "must be a number of seconds >= 0, got {}",
+                args.checkpoint_every
+            ),
+        ));
+    }
+    if let Some(path) = &args.checkpoint {
+        let folder = match path.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p,
+            _ => Path::new("."),
+        };
+        if !folder.is_dir() {
+            return Err(setting(
+                "--checkpoint",
+                format!(
+                    "{}: the folder {} does not exist",
+                    path.display(),
+                    folder.display()
+                ),
+            ));
+        }
+    }
 
     let mut description = load_description(scene_path)?;
-    if let Some(spp) = spp {
+    if let Some(spp) = args.spp {
         if spp == 0 {
             return Err(setting("--spp", "must be >= 1, got 0"));
         }
         description.sampler.spp = spp;
     }
-    if let Some(seed) = seed {
+    if let Some(seed) = args.seed {
         description.sampler.seed = seed;
     }
-    if let Some(name) = integrator {
+    if let Some(name) = args.integrator {
         description.integrator.kind = IntegratorKind::parse(&name).ok_or_else(|| {
             setting("--integrator", format!("unknown integrator `{name}`, expected path, depth, distance, position, normal or albedo"))
         })?;
     }
-    if let Some(r) = resolution {
+    if let Some(r) = args.resolution {
         description.film.resolution = parse_resolution(&r)?;
     }
     for note in &description.ignored {
         eprintln!("note: {note}");
     }
+    // The checkpoint's fingerprint: the scene file's bytes and the settings after overrides.
+    let fingerprint = if args.checkpoint.is_some() || args.resume.is_some() {
+        let source = std::fs::read(scene_path).map_err(|source| RenderError::Io {
+            file: scene_path.to_path_buf(),
+            action: "cannot read the scene file",
+            source,
+        })?;
+        scene_fingerprint(&source, &description)
+    } else {
+        0
+    };
     let scene = RenderScene::build(description)?;
     report_skipped(&scene);
-
     let spp = scene.sampler.samples_per_pixel();
+
+    let resume = match &args.resume {
+        Some(path) => {
+            let checkpoint = Checkpoint::load(path)?;
+            checkpoint.check_matches(fingerprint, spp, scene.pixel_bounds, path)?;
+            Some((checkpoint.film, checkpoint.passes_done))
+        }
+        None => None,
+    };
+    let first_pass = resume.as_ref().map_or(0, |r| r.1);
+
+    let interrupts = Interrupts::install()?;
     let bar = std::io::stderr().is_terminal().then(|| {
         let bar = indicatif::ProgressBar::new(1);
         bar.set_style(
@@ -149,18 +275,87 @@ fn run_render(
             bar.set_position(done);
         }
     };
+    // Checkpoints from the pass callback, when the interval has elapsed. A failed save warns
+    // and the render goes on: losing the checkpoint is better than losing the render.
+    let interval = Duration::from_secs_f64(args.checkpoint_every);
+    let last_save = Mutex::new(Instant::now());
+    let save = |passes_done: u32, film: &Film| {
+        let Some(path) = &args.checkpoint else {
+            return;
+        };
+        let checkpoint = Checkpoint {
+            fingerprint,
+            samples_per_pixel: spp,
+            passes_done,
+            film: film.clone(),
+        };
+        if let Err(e) = checkpoint.save(path) {
+            let message = format!("warning: {e}");
+            match &bar {
+                Some(bar) => bar.println(message),
+                None => eprintln!("{message}"),
+            }
+        }
+    };
+    let on_pass = |passes_done: u32, _spp: u32, film: &Film| {
+        if args.checkpoint.is_none() || passes_done >= spp {
+            return;
+        }
+        let mut last = last_save.lock().unwrap_or_else(|e| e.into_inner());
+        if last.elapsed() >= interval {
+            save(passes_done, film);
+            *last = Instant::now();
+        }
+    };
     let outcome = render(
         &scene,
         RenderOptions {
             threads,
+            cancel: Some(&interrupts.cancel),
+            on_pass: Some(&on_pass),
             on_tile: Some(&on_tile),
-            ..RenderOptions::default()
+            resume,
         },
     )
     .map_err(|e| setting("--threads", format!("cannot start the worker threads: {e}")))?;
     if let Some(bar) = &bar {
         bar.finish_and_clear();
     }
+    let complete = outcome.is_complete(&scene);
+    // The final or interrupted state, before the image: a second signal from here on loses
+    // at most the image, never the samples.
+    save(outcome.passes_done, &outcome.film);
+
+    if !complete {
+        let signal = interrupts.received().unwrap_or(SIGINT);
+        let status = 128 + signal as u8;
+        if outcome.passes_done == 0 {
+            eprintln!(
+                "interrupted before the first pass finished: wrote nothing ({} left as it was)",
+                output.display()
+            );
+            return Ok(ExitCode::from(status));
+        }
+        write_image(
+            &output,
+            &outcome.film.resolve(),
+            &ImageInfo {
+                partial: true,
+                samples_per_pixel: outcome.passes_done,
+            },
+        )?;
+        eprintln!(
+            "interrupted: wrote partial image {} ({} of {spp} samples per pixel){}",
+            output.display(),
+            outcome.passes_done,
+            args.checkpoint
+                .as_ref()
+                .map(|c| format!("; resume with --resume {}", c.display()))
+                .unwrap_or_default()
+        );
+        return Ok(ExitCode::from(status));
+    }
+
     let image = outcome.film.resolve();
     write_image(
         &output,
@@ -176,9 +371,14 @@ fn run_render(
     let threads_used =
         threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
     let mut summary = format!(
-        "rendered {} -> {}: {w}x{h}, {spp} spp, {} integrator, {:.2} M samples in {:.2} s ({:.2} M camera rays/s, {threads_used} threads)",
+        "rendered {} -> {}: {w}x{h}, {spp} spp{}, {} integrator, {:.2} M samples in {:.2} s ({:.2} M camera rays/s, {threads_used} threads)",
         scene_path.display(),
         output.display(),
+        if first_pass > 0 {
+            format!(" (resumed at {first_pass})")
+        } else {
+            String::new()
+        },
         scene.integrator().name(),
         outcome.stats.samples as f64 / 1e6,
         secs,
@@ -191,7 +391,7 @@ fn run_render(
         ));
     }
     println!("{summary}");
-    Ok(())
+    Ok(ExitCode::SUCCESS)
 }
 
 fn parse_resolution(r: &str) -> Result<[u32; 2], RenderError> {

@@ -59,5 +59,5 @@ pub mod testmesh;
 pub use error::AccelError;
 pub use hit::{Hit, SHADOW_EPSILON};
 pub use mesh::TriangleMesh;
-pub use obj::load_obj;
+pub use obj::{load_obj, parse_obj};
 pub use scene::{BuildQuality, Placement, Scene, SceneBuilder, Shape};

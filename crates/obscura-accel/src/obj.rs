@@ -19,6 +19,12 @@ pub fn load_obj(path: &Path) -> Result<TriangleMesh, AccelError> {
         path: path.to_path_buf(),
         reason: e.to_string(),
     })?;
+    parse_obj(&bytes, path)
+}
+
+/// Parses the bytes of an OBJ file as [`load_obj`] does; `path` only names the file in errors.
+/// Any bytes give a mesh or an error, never a panic (the fuzz target `obj` feeds it).
+pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<TriangleMesh, AccelError> {
     let obj_error = |line: Option<usize>, reason: String| AccelError::Obj {
         path: path.to_path_buf(),
         line,
@@ -31,7 +37,7 @@ pub fn load_obj(path: &Path) -> Result<TriangleMesh, AccelError> {
             "binary data (a NUL byte): this is not a text OBJ file".to_string(),
         ));
     }
-    let text = match std::str::from_utf8(&bytes) {
+    let text = match std::str::from_utf8(bytes) {
         Ok(text) => text,
         Err(e) => {
             let at = e.valid_up_to();

@@ -192,7 +192,8 @@ impl PathIntegrator {
     }
 
     /// Radiance arriving along `ray` (world space, its own time), with further sample
-    /// dimensions drawn from `dims`. Never NaN or infinite for a well-formed scene.
+    /// dimensions drawn from `dims`. Never NaN or infinite: a value that overflowed is
+    /// replaced by zero (see [`PathIntegrator::li_and_hit`] for the raw value).
     pub fn li(
         &self,
         geometry: &Scene,
@@ -200,11 +201,16 @@ impl PathIntegrator {
         ray: &Ray<World>,
         dims: &mut impl SampleDims,
     ) -> Vec3 {
-        self.li_and_hit(geometry, shading, ray, dims).0
+        let l = self.trace(geometry, shading, ray, dims).0;
+        if l.is_finite() { l } else { Vec3::ZERO }
     }
 
-    /// [`PathIntegrator::li`], and whether `ray` itself hit geometry (the film's coverage), at
-    /// the cost of one path.
+    /// Radiance along `ray` as [`PathIntegrator::li`] computes it, and whether `ray` itself hit
+    /// geometry (the film's coverage), at the cost of one path.
+    ///
+    /// Unlike `li`, the radiance is returned raw: it may be NaN or infinite when the scene's
+    /// numbers overflow (e.g. an emission near `f32::MAX`). The renderer counts such samples
+    /// and drops them, which it could not do if they were silently replaced by zero.
     pub fn li_and_hit(
         &self,
         geometry: &Scene,
@@ -212,8 +218,7 @@ impl PathIntegrator {
         ray: &Ray<World>,
         dims: &mut impl SampleDims,
     ) -> (Vec3, bool) {
-        let (l, hit) = self.trace(geometry, shading, ray, dims);
-        (if l.is_finite() { l } else { Vec3::ZERO }, hit)
+        self.trace(geometry, shading, ray, dims)
     }
 
     fn trace(
