@@ -45,6 +45,8 @@ pub use obscura_sample as sample;
 pub use obscura_shade as shade;
 pub use obscura_space as space;
 
+pub mod gallery;
+
 /// The README's examples, compiled and run as doctests so they stay true.
 #[cfg(doctest)]
 #[doc = include_str!("../README.md")]

@@ -1,0 +1,297 @@
+//! The illustrated guide's pictures, made from the scenes in `docs/gallery/` by one command:
+//! `cargo run --release --example gallery -- [--quick] [OUT_DIR]` (default `docs/gallery`).
+//!
+//! Each figure is a scene file (embedded here, and written into `OUT_DIR` beside its picture)
+//! rendered once or several times with parameters varied, the panels laid side by side into one
+//! opaque PNG of the same name. [`generate`] does it all; [`FIGURES`] names what it makes.
+
+use obscura_render::{
+    DepthOfField, Image, ImageInfo, RenderError, RenderOptions, RenderScene, SceneDescription,
+    depth_of_field, motion_blur, parse_description, render, screen_buffers, write_image,
+};
+use std::path::{Path, PathBuf};
+
+/// How big and how clean the pictures are.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Quality {
+    /// The committed pictures: panels of about 240x180 at up to 256 samples per pixel.
+    Full,
+    /// Tiny panels and few samples, for tests: every picture is made, in seconds.
+    Quick,
+}
+
+impl Quality {
+    /// A panel's resolution for a scene written at `full` resolution.
+    fn resolution(self, full: [u32; 2]) -> [u32; 2] {
+        match self {
+            Quality::Full => full,
+            Quality::Quick => full.map(|v| (v / 8).max(4)),
+        }
+    }
+    /// Samples per pixel for a scene asking for `full`.
+    fn spp(self, full: u32) -> u32 {
+        match self {
+            Quality::Full => full,
+            Quality::Quick => (full / 64).clamp(1, 4),
+        }
+    }
+}
+
+/// One figure: a scene file and the picture made from it.
+#[derive(Debug, Clone, Copy)]
+pub struct Figure {
+    /// The file stem: the scene is `NAME.toml`, the picture `NAME.png`.
+    pub name: &'static str,
+    /// The scene file's text.
+    scene: &'static str,
+}
+
+macro_rules! figure {
+    ($name:literal) => {
+        Figure {
+            name: $name,
+            scene: include_str!(concat!("../docs/gallery/", $name, ".toml")),
+        }
+    };
+}
+
+/// Every figure the gallery makes, in order.
+pub const FIGURES: [Figure; 11] = [
+    figure!("projection-perspective"),
+    figure!("projection-orthographic"),
+    figure!("dof-lens-radius"),
+    figure!("dof-focal-distance"),
+    figure!("undersampling"),
+    figure!("motion-object"),
+    figure!("motion-camera"),
+    figure!("motion-shadow-reflection"),
+    figure!("panorama"),
+    figure!("postprocess-dof"),
+    figure!("postprocess-motion"),
+];
+
+/// The lens radii of the `dof-lens-radius` row.
+pub const LENS_RADII: [f32; 4] = [0.0, 0.1, 0.2, 0.4];
+/// The focal distances of the `dof-focal-distance` row: the camera-space depths of the five
+/// spheres' centres in that scene.
+pub const FOCAL_DISTANCES: [f32; 5] = [3.07, 5.06, 7.05, 9.03, 11.02];
+/// The samples per pixel of the `undersampling` row.
+pub const UNDERSAMPLING_SPP: [u32; 5] = [1, 4, 16, 64, 256];
+
+/// What a figure's panels were, for the caller to print.
+#[derive(Debug, Clone)]
+pub struct Made {
+    /// The picture written.
+    pub png: PathBuf,
+    /// Its size in pixels.
+    pub size: [u32; 2],
+    /// For the comparison figures: the 4x3 grid cells (column, row, of the difference panel) with
+    /// the largest mean difference, largest first, with that mean.
+    pub hot_cells: Vec<(u32, u32, f32)>,
+}
+
+/// Makes every figure into `out_dir` (created if needed): `NAME.toml` and `NAME.png` for each of
+/// [`FIGURES`]. `on_figure` is told of each picture as it is written.
+pub fn generate(
+    out_dir: &Path,
+    quality: Quality,
+    mut on_figure: impl FnMut(&Made),
+) -> Result<Vec<Made>, RenderError> {
+    std::fs::create_dir_all(out_dir).map_err(|source| RenderError::Io {
+        file: out_dir.to_path_buf(),
+        action: "cannot create the folder",
+        source,
+    })?;
+    let mut made = Vec::new();
+    for figure in FIGURES {
+        let m = make_figure(out_dir, figure, quality)?;
+        on_figure(&m);
+        made.push(m);
+    }
+    Ok(made)
+}
+
+fn make_figure(out_dir: &Path, figure: Figure, quality: Quality) -> Result<Made, RenderError> {
+    // Write the scene beside its picture (unless it is already there, unchanged).
+    let scene_path = out_dir.join(format!("{}.toml", figure.name));
+    if std::fs::read_to_string(&scene_path).ok().as_deref() != Some(figure.scene) {
+        std::fs::write(&scene_path, figure.scene).map_err(|source| RenderError::Io {
+            file: scene_path.clone(),
+            action: "cannot write",
+            source,
+        })?;
+    }
+    let mut base = parse_description(&scene_path, figure.scene)?;
+    base.film.resolution = quality.resolution(base.film.resolution);
+    base.sampler.spp = quality.spp(base.sampler.spp);
+
+    let mut hot_cells = Vec::new();
+    let panels: Vec<Image> = match figure.name {
+        "dof-lens-radius" => LENS_RADII
+            .iter()
+            .map(|&r| {
+                let mut d = base.clone();
+                d.camera.lens_radius = r;
+                shoot(d)
+            })
+            .collect::<Result<_, _>>()?,
+        "dof-focal-distance" => FOCAL_DISTANCES
+            .iter()
+            .map(|&f| {
+                let mut d = base.clone();
+                d.camera.focal_distance = f;
+                shoot(d)
+            })
+            .collect::<Result<_, _>>()?,
+        "undersampling" => UNDERSAMPLING_SPP
+            .iter()
+            .map(|&spp| {
+                let mut d = base.clone();
+                d.sampler.spp = match quality {
+                    Quality::Full => spp,
+                    Quality::Quick => spp.min(4),
+                };
+                shoot(d)
+            })
+            .collect::<Result<_, _>>()?,
+        "postprocess-dof" | "postprocess-motion" => {
+            let (distributed, post) = compare(base, figure.name == "postprocess-dof")?;
+            let diff = difference(&distributed, &post);
+            hot_cells = hottest_cells(&distributed, &post);
+            vec![distributed, post, diff]
+        }
+        _ => vec![shoot(base)?],
+    };
+    let row = side_by_side(&panels);
+    let png = out_dir.join(format!("{}.png", figure.name));
+    write_image(
+        &png,
+        &row,
+        &ImageInfo {
+            partial: false,
+            samples_per_pixel: 0,
+        },
+    )?;
+    Ok(Made {
+        png,
+        size: [row.width, row.height],
+        hot_cells,
+    })
+}
+
+/// Renders a description with every core and returns its image made opaque: the sky's
+/// radiance is already in RGB, so only the coverage in alpha is dropped.
+fn shoot(description: SceneDescription) -> Result<Image, RenderError> {
+    let scene = RenderScene::build(description)?;
+    Ok(opaque(render_scene(&scene)?))
+}
+
+fn render_scene(scene: &RenderScene) -> Result<Image, RenderError> {
+    let outcome = render(scene, RenderOptions::default()).map_err(|e| RenderError::Setting {
+        name: "threads",
+        message: format!("cannot start the render's worker threads: {e}"),
+    })?;
+    Ok(outcome.film.resolve())
+}
+
+fn opaque(mut image: Image) -> Image {
+    for p in &mut image.pixels {
+        p[3] = 1.0;
+    }
+    image
+}
+
+/// The same scene rendered Cook-style (distributed over lens or shutter) and by post-processing
+/// a pinhole image at shutter open with its depth or velocity buffer.
+fn compare(base: SceneDescription, defocus: bool) -> Result<(Image, Image), RenderError> {
+    let scene = RenderScene::build(base.clone())?;
+    let distributed = opaque(render_scene(&scene)?);
+    let buffers = screen_buffers(&scene);
+    // The pinhole image: no lens, and an instant shutter at the scene's shutter open.
+    let mut pinhole = base;
+    pinhole.camera.lens_radius = 0.0;
+    pinhole.camera.shutter[1] = pinhole.camera.shutter[0];
+    let sharp = render_scene(&RenderScene::build(pinhole)?)?;
+    let post = if defocus {
+        let params = DepthOfField::for_camera(&scene.camera)?;
+        depth_of_field(&sharp, &buffers.depth, &params)?
+    } else {
+        motion_blur(&sharp, &buffers.velocity)?
+    };
+    Ok((distributed, opaque(post)))
+}
+
+/// `|a - b|` summed over RGB (display-clamped first), times 4, in false colour: black, red,
+/// yellow, white as the difference grows.
+pub fn difference(a: &Image, b: &Image) -> Image {
+    let pixels = a
+        .pixels
+        .iter()
+        .zip(&b.pixels)
+        .map(|(p, q)| {
+            let d: f32 = (0..3)
+                .map(|k| (p[k].clamp(0.0, 1.0) - q[k].clamp(0.0, 1.0)).abs())
+                .sum::<f32>()
+                * 4.0
+                / 3.0;
+            [
+                d.clamp(0.0, 1.0),
+                (d - 1.0).clamp(0.0, 1.0),
+                (d - 2.0).clamp(0.0, 1.0),
+                1.0,
+            ]
+        })
+        .collect();
+    Image {
+        width: a.width,
+        height: a.height,
+        pixels,
+    }
+}
+
+/// The cells of a 4x3 grid over the image ordered by mean `|a - b|` (RGB mean), largest first.
+fn hottest_cells(a: &Image, b: &Image) -> Vec<(u32, u32, f32)> {
+    let (cols, rows) = (4u32, 3u32);
+    let mut cells = Vec::new();
+    for cy in 0..rows {
+        for cx in 0..cols {
+            let (x0, x1) = (cx * a.width / cols, (cx + 1) * a.width / cols);
+            let (y0, y1) = (cy * a.height / rows, (cy + 1) * a.height / rows);
+            let mut sum = 0.0;
+            let mut n = 0.0;
+            for y in y0..y1 {
+                for x in x0..x1 {
+                    let (p, q) = (a.pixel(x, y), b.pixel(x, y));
+                    sum += (0..3).map(|k| (p[k] - q[k]).abs()).sum::<f32>() / 3.0;
+                    n += 1.0;
+                }
+            }
+            cells.push((cx, cy, if n > 0.0 { sum / n } else { 0.0 }));
+        }
+    }
+    cells.sort_by(|p, q| q.2.total_cmp(&p.2));
+    cells
+}
+
+/// Panels of equal height laid left to right with a 4-pixel white gap between them.
+pub fn side_by_side(panels: &[Image]) -> Image {
+    const GAP: u32 = 4;
+    let height = panels.iter().map(|p| p.height).max().unwrap_or(1);
+    let width =
+        panels.iter().map(|p| p.width).sum::<u32>() + GAP * (panels.len() as u32).saturating_sub(1);
+    let mut pixels = vec![[1.0; 4]; (width * height) as usize];
+    let mut x0 = 0;
+    for panel in panels {
+        for y in 0..panel.height {
+            for x in 0..panel.width {
+                pixels[(y * width + x0 + x) as usize] = panel.pixel(x, y);
+            }
+        }
+        x0 += panel.width + GAP;
+    }
+    Image {
+        width: width.max(1),
+        height,
+        pixels,
+    }
+}
