@@ -528,17 +528,47 @@ mod tests {
     }
 
     #[test]
-    fn the_thin_lens_circle_is_where_the_sample_rays_land() {
-        // Independent of the closed form: trace the lens edge ray L = (r, 0) towards the focal
-        // point of the film position a, and solve for the a whose ray meets P = (0, 0, z).
-        // Ray: L + (a f - L) s / f at depth s; at s = z: x = r + (a f - r) z / f = 0, so
-        // a = r (z - f) / (z f) ... = -r (1/f - 1/z); for r = 0.2, f = 3, z = 6:
-        // a = 0.2 * 3 / 18 = 1/30 in units at z = 1; times k = 90: 3 pixels.
-        let (r, f, z, k) = (0.2_f32, 3.0_f32, 6.0_f32, 90.0_f32);
-        let a = r * (z - f) / (z * f);
-        assert!((a * k - 3.0).abs() < 1e-5);
-        let c = circle_of_confusion(z, f, r, k).unwrap();
-        assert!((c - 3.0).abs() < 1e-5, "{c}");
+    fn the_camera_s_own_lens_rays_spread_a_point_over_the_circle_of_confusion() {
+        // Eye at the origin looking down world -z, so camera (x, y, z) = world (x, y, -z).
+        // 200x100 film: window [-2, 2] x [-1, 1]; fov 90 on the smaller (y) axis: s = 1, so
+        // k = s * width / (x_max - x_min) = 200 / 4 = 50 pixels per unit at z = 1.
+        let toml = r#"
+            [film]
+            resolution = [200, 100]
+            [camera]
+            eye = [0.0, 0.0, 0.0]
+            target = [0.0, 0.0, -1.0]
+            fov = 90.0
+            lens_radius = 0.2
+            focal_distance = 2.0
+        "#;
+        let scene =
+            RenderScene::build(crate::parse_description("t.toml".as_ref(), toml).unwrap()).unwrap();
+        let params = DepthOfField::for_camera(&scene.camera).unwrap();
+        assert!((params.pixels_per_unit - 50.0).abs() < 1e-3, "{params:?}");
+        // P at camera (0.3, 0.1, 4): c = 0.2 * |1/4 - 1/2| * 50 = 2.5 pixels.
+        let c = params.radius(4.0).unwrap();
+        assert!((c - 2.5).abs() < 1e-4, "{c}");
+        // The lens edge point L = (0.2, 0) sees P from the film point a = P/z - L (1/z - 1/f)
+        // = (0.075 + 0.05, 0.025) on z = 1: raster x = (0.125 + 2) / 4 * 200 = 106.25,
+        // y = (1 - 0.025) / 2 * 100 = 48.75; the pinhole image of P is at x = 103.75: 2.5 away.
+        let sample = CameraSample {
+            p_film: Point2::new(106.25, 48.75),
+            // The concentric disk maps (1, 0.5) to the disk's edge at (1, 0).
+            p_lens: Vec2::new(1.0, 0.5),
+            time: 0.0,
+        };
+        let ray = scene.camera.generate_ray(&sample).unwrap().ray;
+        let p_world = glam::Vec3::new(0.3, 0.1, -4.0);
+        let (o, d) = (ray.origin.to_glam(), ray.direction.to_glam());
+        let miss = (p_world - o).cross(d).length();
+        assert!(miss < 1e-4, "the lens-edge ray misses P by {miss}");
+        // And the pinhole ray of P lands 2.5 pixels to the left.
+        let pinhole = scene
+            .camera
+            .project(obscura_space::Point3::new(0.3, 0.1, -4.0), 0.0);
+        let pinhole = pinhole.unwrap();
+        assert!((106.25 - pinhole.x - c).abs() < 1e-3, "{}", pinhole.x);
     }
 
     #[test]
