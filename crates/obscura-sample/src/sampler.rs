@@ -162,6 +162,21 @@ impl Sampler {
         }
     }
 
+    /// Dimensions `first` and `first + 1` (`first` even), as two [`Sampler::value_keyed`]
+    /// calls would give them; Sobol computes its per-pair hashes once.
+    #[inline]
+    fn pair_keyed(&self, pixel_key: u64, index: u32, first: u32) -> Vec2 {
+        match self.kind {
+            SamplerKind::Sobol if first.is_multiple_of(2) => {
+                Vec2::from(sequences::sobol_pair(pixel_key, index, first / 2))
+            }
+            _ => Vec2::new(
+                self.value_keyed(pixel_key, index, first),
+                self.value_keyed(pixel_key, index, first.saturating_add(1)),
+            ),
+        }
+    }
+
     /// A cursor over the dimensions of sample `index` of `pixel`. No heap allocation.
     #[inline]
     pub fn stream(&self, pixel: [u32; 2], index: u32) -> SampleStream<'_> {
@@ -208,14 +223,11 @@ impl SampleStream<'_> {
     /// dimensions 0-4 and moves the cursor to at least 5.
     #[inline]
     pub fn camera(&mut self) -> CameraDims {
-        let value = |dimension| {
-            self.sampler
-                .value_keyed(self.pixel_key, self.index, dimension)
-        };
+        let (sampler, key, index) = (self.sampler, self.pixel_key, self.index);
         let dims = CameraDims {
-            film: Vec2::new(value(0), value(1)),
-            lens: Vec2::new(value(2), value(3)),
-            time: value(4),
+            film: sampler.pair_keyed(key, index, 0),
+            lens: sampler.pair_keyed(key, index, 2),
+            time: sampler.value_keyed(key, index, 4),
         };
         self.dimension = self.dimension.max(5);
         dims
@@ -235,11 +247,7 @@ impl SampleStream<'_> {
     #[inline]
     pub fn next_2d(&mut self) -> Vec2 {
         let first = self.dimension.saturating_add(self.dimension % 2);
-        let u2 = Vec2::new(
-            self.sampler.value_keyed(self.pixel_key, self.index, first),
-            self.sampler
-                .value_keyed(self.pixel_key, self.index, first.saturating_add(1)),
-        );
+        let u2 = self.sampler.pair_keyed(self.pixel_key, self.index, first);
         self.dimension = first.saturating_add(2);
         u2
     }
@@ -279,6 +287,30 @@ mod tests {
         );
         assert!(Sampler::new(SamplerKind::Halton, MAX_SAMPLES_PER_PIXEL + 1, 0).is_err());
         assert!(Sampler::new(SamplerKind::Halton, MAX_SAMPLES_PER_PIXEL, 0).is_ok());
+    }
+
+    #[test]
+    fn pairs_equal_two_single_values_for_every_kind() {
+        // The stream's paired path (Sobol hashes each pair once) must give exactly the values
+        // of the one-dimension path, which the sequence tests check.
+        for kind in SamplerKind::ALL {
+            let sampler = Sampler::new(kind, 16, 3).unwrap();
+            for (pixel, index) in [([0, 0], 0), ([7, 2], 5), ([1000, 31], 15)] {
+                let v = |d| sampler.value(pixel, index, d);
+                let mut stream = sampler.stream(pixel, index);
+                let dims = stream.camera();
+                assert_eq!(dims.film, Vec2::new(v(0), v(1)), "{kind:?}");
+                assert_eq!(dims.lens, Vec2::new(v(2), v(3)), "{kind:?}");
+                assert_eq!(dims.time, v(4), "{kind:?}");
+                for first in [6, 8, 10] {
+                    assert_eq!(
+                        stream.next_2d(),
+                        Vec2::new(v(first), v(first + 1)),
+                        "{kind:?}"
+                    );
+                }
+            }
+        }
     }
 
     #[test]
