@@ -1,7 +1,10 @@
-//! BVH build time and ray throughput on generated geodesic spheres, one thread.
+//! BVH build time and ray throughput on generated meshes of about 100k and 1M triangles (a
+//! geodesic icosphere and a displaced grid), one thread.
 //!
 //! `cargo bench -p obscura-accel -- --quick`. Throughput is reported in rays (elements) per
-//! second: coherent primary rays from a pinhole grid, incoherent rays between random points.
+//! second: coherent primary rays from a pinhole grid, incoherent rays between random points,
+//! each as a closest-hit query and as a shadow (any-hit) query. `bench/compare.py` traces the
+//! same kinds of rays through Embree for the ratios in docs/performance.md.
 
 // criterion_group! generates an undocumented function.
 #![allow(missing_docs)]
@@ -12,8 +15,14 @@ use obscura_space::{Point3, Ray, Transform, Vector3, World};
 use std::hint::black_box;
 use std::sync::Arc;
 
-/// 20 * 4^6 = 81,920 and 20 * 4^8 = 1,310,720 triangles.
-const SUBDIVISIONS: [u32; 2] = [6, 8];
+/// Icospheres of 20 * 4^6 = 81,920 and 20 * 4^8 = 1,310,720 triangles, and displaced grids of
+/// 2 * 224^2 = 100,352 and 2 * 724^2 = 1,048,352 triangles.
+const MESHES: [(&str, u32); 4] = [
+    ("icosphere", 6),
+    ("icosphere", 8),
+    ("grid", 224),
+    ("grid", 724),
+];
 
 fn scene_of(mesh: &Arc<obscura_accel::TriangleMesh>) -> Scene {
     let mut builder = SceneBuilder::new();
@@ -26,7 +35,8 @@ fn scene_of(mesh: &Arc<obscura_accel::TriangleMesh>) -> Scene {
     builder.build().unwrap()
 }
 
-/// A 256 x 256 pinhole grid from (0, 0, 3) looking down -z over a 60-degree square field.
+/// A 256 x 256 pinhole grid from (0, 0, 3) looking down -z over a 60-degree square field (both
+/// meshes lie within the unit cube around the origin: the sphere, and the grid facing +z).
 fn primary_rays() -> Vec<Ray<World>> {
     let n = 256;
     let half = (30.0f32).to_radians().tan();
@@ -71,20 +81,23 @@ fn random_rays() -> Vec<Ray<World>> {
 fn bench(c: &mut Criterion) {
     let primary = primary_rays();
     let random = random_rays();
-    for n in SUBDIVISIONS {
-        let mesh = Arc::new(testmesh::icosphere(n).unwrap());
+    for (kind, n) in MESHES {
+        let mesh = Arc::new(match kind {
+            "icosphere" => testmesh::icosphere(n).unwrap(),
+            _ => testmesh::displaced_grid(n).unwrap(),
+        });
         let tris = mesh.triangle_count();
 
         let mut build = c.benchmark_group("build");
         build.sample_size(10);
         build.throughput(Throughput::Elements(tris as u64));
-        build.bench_function(BenchmarkId::new("icosphere", tris), |b| {
+        build.bench_function(BenchmarkId::new(kind, tris), |b| {
             b.iter(|| black_box(scene_of(&mesh)))
         });
         build.finish();
 
         let scene = scene_of(&mesh);
-        let mut trace = c.benchmark_group(format!("trace_{tris}_tris"));
+        let mut trace = c.benchmark_group(format!("trace_{kind}_{tris}_tris"));
         trace.sample_size(10);
         for (name, rays) in [
             ("primary_coherent", &primary),
@@ -94,7 +107,7 @@ fn bench(c: &mut Criterion) {
             trace.bench_function(format!("{name}_closest"), |b| {
                 b.iter(|| rays.iter().filter(|r| scene.intersect(r).is_some()).count())
             });
-            trace.bench_function(format!("{name}_occluded"), |b| {
+            trace.bench_function(format!("{name}_shadow_anyhit"), |b| {
                 b.iter(|| rays.iter().filter(|r| scene.occluded(r)).count())
             });
         }

@@ -1,0 +1,194 @@
+//! The Obscura side of the side-by-side harness (`bench/compare.py` runs it).
+//!
+//! `cargo run --release --example obscura-side -- MESH SIZE DIR` builds the generated mesh
+//! (`icosphere` with SIZE subdivisions, or `grid` of SIZE x SIZE quads), writes it and the ray
+//! sets to DIR as raw little-endian arrays so the peers trace exactly the same data, then
+//! measures build time and one-thread closest-hit and occlusion throughput and prints one JSON
+//! object on stdout. Run by hand, never by the test suite.
+
+use camera_obscura::accel::{Placement, Scene, SceneBuilder, Shape, TriangleMesh, testmesh};
+use camera_obscura::space::{Point3, Ray, Transform, Vector3, World};
+use std::hint::black_box;
+use std::io::Write;
+use std::path::Path;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// Rays per set: a 256 x 256 pinhole grid, and as many incoherent rays.
+const SIDE: usize = 256;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().collect();
+    let [_, kind, size, dir] = args.as_slice() else {
+        return Err("usage: obscura-side icosphere|grid SIZE DIR".into());
+    };
+    let size: u32 = size.parse()?;
+    let mesh = Arc::new(match kind.as_str() {
+        "icosphere" => testmesh::icosphere(size)?,
+        "grid" => testmesh::displaced_grid(size)?,
+        other => return Err(format!("unknown mesh {other:?}").into()),
+    });
+    let dir = Path::new(dir);
+    std::fs::create_dir_all(dir)?;
+    write_mesh(&mesh, dir)?;
+
+    // Bounding sphere of the mesh: every ray set is framed on it.
+    let b = mesh.bounds();
+    let center = b.min.to_glam().lerp(b.max.to_glam(), 0.5);
+    let radius = (b.max.to_glam() - b.min.to_glam()).length() * 0.5;
+    let sets = [
+        ("primary", primary_rays(center, radius)),
+        (
+            "random",
+            random_rays(center, radius, b.min.to_glam(), b.max.to_glam()),
+        ),
+        ("miss", miss_rays(center, radius)),
+    ];
+    for (name, rays) in &sets {
+        write_rays(rays, &dir.join(format!("rays_{name}.bin")))?;
+    }
+
+    // Build: best of three (the first also pages the mesh in).
+    let mut build_s = f64::INFINITY;
+    let mut scene = None;
+    for _ in 0..3 {
+        let start = Instant::now();
+        let s = scene_of(&mesh);
+        build_s = build_s.min(start.elapsed().as_secs_f64());
+        scene = Some(s);
+    }
+    let scene = scene.expect("built three times");
+
+    let mut out = format!(
+        "{{\"triangles\": {}, \"build_s\": {build_s:.6}",
+        mesh.triangle_count()
+    );
+    for (name, rays) in &sets {
+        let closest = rate(rays, |r| scene.intersect(r).is_some());
+        let occluded = rate(rays, |r| scene.occluded(r));
+        let hits = rays.iter().filter(|r| scene.intersect(r).is_some()).count();
+        out += &format!(
+            ", \"{name}_closest_rps\": {closest:.1}, \"{name}_occluded_rps\": {occluded:.1}, \"{name}_hits\": {hits}"
+        );
+    }
+    out += "}";
+    println!("{out}");
+    Ok(())
+}
+
+fn scene_of(mesh: &Arc<TriangleMesh>) -> Scene {
+    let mut builder = SceneBuilder::new();
+    builder
+        .add(
+            Shape::Mesh(mesh.clone()),
+            Placement::Static(Transform::IDENTITY),
+        )
+        .expect("a generated mesh is valid");
+    builder.build().expect("a generated mesh builds")
+}
+
+/// Rays per second, best of five passes over the set.
+fn rate(rays: &[Ray<World>], mut query: impl FnMut(&Ray<World>) -> bool) -> f64 {
+    let mut best = f64::INFINITY;
+    for _ in 0..5 {
+        let start = Instant::now();
+        let n = rays.iter().filter(|r| query(r)).count();
+        black_box(n);
+        best = best.min(start.elapsed().as_secs_f64());
+    }
+    rays.len() as f64 / best
+}
+
+/// A pinhole grid from outside the bounding sphere, its field just covering the sphere.
+fn primary_rays(center: glam::Vec3, radius: f32) -> Vec<Ray<World>> {
+    let back = glam::Vec3::new(0.2, 0.6, 1.0).normalize();
+    let eye = center + back * (2.5 * radius);
+    // Camera frame looking at the centre.
+    let w = -back;
+    let u = w.cross(glam::Vec3::Y).normalize();
+    let v = u.cross(w);
+    let half = (1.0f32 / 2.5).asin().tan();
+    let mut rays = Vec::with_capacity(SIDE * SIDE);
+    for j in 0..SIDE {
+        for i in 0..SIDE {
+            let x = ((i as f32 + 0.5) / SIDE as f32 * 2.0 - 1.0) * half;
+            let y = (1.0 - (j as f32 + 0.5) / SIDE as f32 * 2.0) * half;
+            let d = (w + u * x + v * y).normalize();
+            rays.push(ray(eye, d));
+        }
+    }
+    rays
+}
+
+/// From random points on a sphere of 1.5x the bounding radius to random points in the box
+/// (a fixed xorshift sequence, so every run traces the same rays).
+fn random_rays(center: glam::Vec3, radius: f32, lo: glam::Vec3, hi: glam::Vec3) -> Vec<Ray<World>> {
+    let mut state = 0x2545_F491_4F6C_DD1Du64;
+    let mut u = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 40) as f32 / (1u64 << 24) as f32
+    };
+    (0..SIDE * SIDE)
+        .map(|_| {
+            let dir = loop {
+                let v = glam::Vec3::new(2.0 * u() - 1.0, 2.0 * u() - 1.0, 2.0 * u() - 1.0);
+                let l = v.length();
+                if l > 0.1 && l <= 1.0 {
+                    break v / l;
+                }
+            };
+            let origin = center + dir * (1.5 * radius);
+            let target = lo + (hi - lo) * glam::Vec3::new(u(), u(), u());
+            ray(origin, (target - origin).normalize())
+        })
+        .collect()
+}
+
+/// Rays that start outside the box and point away from it: they measure the fixed cost of a
+/// query (for embreex, mostly the Python-to-Embree call).
+fn miss_rays(center: glam::Vec3, radius: f32) -> Vec<Ray<World>> {
+    (0..SIDE * SIDE)
+        .map(|k| {
+            let a = k as f32 * 0.001;
+            let d = glam::Vec3::new(1.0, 0.3 * a.sin(), 0.3 * a.cos()).normalize();
+            ray(center + d * (2.0 * radius), d)
+        })
+        .collect()
+}
+
+fn ray(o: glam::Vec3, d: glam::Vec3) -> Ray<World> {
+    Ray::new(Point3::from_glam(o), Vector3::from_glam(d), 0.0)
+}
+
+fn write_mesh(mesh: &TriangleMesh, dir: &Path) -> std::io::Result<()> {
+    let mut f = std::io::BufWriter::new(std::fs::File::create(dir.join("positions.f32"))?);
+    for p in mesh.positions() {
+        for c in p.to_array() {
+            f.write_all(&c.to_le_bytes())?;
+        }
+    }
+    f.flush()?;
+    let mut f = std::io::BufWriter::new(std::fs::File::create(dir.join("triangles.u32"))?);
+    for t in mesh.triangles() {
+        for c in t {
+            f.write_all(&c.to_le_bytes())?;
+        }
+    }
+    f.flush()
+}
+
+/// Six f32 per ray: origin then unit direction.
+fn write_rays(rays: &[Ray<World>], path: &Path) -> std::io::Result<()> {
+    let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
+    for r in rays {
+        for c in r.origin.to_glam().to_array() {
+            f.write_all(&c.to_le_bytes())?;
+        }
+        for c in r.direction.to_glam().to_array() {
+            f.write_all(&c.to_le_bytes())?;
+        }
+    }
+    f.flush()
+}
