@@ -8,7 +8,10 @@
 //!   (`obscura-accel`), materials and lights (`obscura-shade`) and a sampler;
 //! - [`render`] takes the samples in passes of one per pixel over 16x16 tiles, in parallel,
 //!   splatting each into a [`Film`] through its reconstruction [`Filter`];
-//! - [`write_image`] writes EXR or PNG atomically.
+//! - [`write_image`] writes EXR or PNG atomically;
+//! - [`depth_of_field`] and [`motion_blur`] are Potmesil and Chakravarty's post-process blurs of
+//!   a pinhole image by its [`screen_buffers`], for comparison with the distributed ray tracing
+//!   that the renderer does.
 //!
 //! The decision to know: tiles accumulate into their own buffers, merged into the film in tile
 //! order after each batch, and a render is a fixed sequence of passes. So the image is

@@ -138,6 +138,15 @@ fn check_depth(depth: f32) -> Result<(), RenderError> {
 ///
 /// Errors (never NaN): `depth` not > 0, `focal_distance` not finite and > 0, `lens_radius` not
 /// finite and >= 0, `pixels_per_unit_at_z1` not finite and > 0.
+///
+/// ```
+/// // r = 0.1, f = 2, a point at z = 4, 100 pixels per unit at z = 1: 0.1 * |1/4 - 1/2| * 100.
+/// let c = obscura_render::circle_of_confusion(4.0, 2.0, 0.1, 100.0)?;
+/// assert!((c - 2.5).abs() < 1e-6);
+/// // In focus: no blur at all.
+/// assert_eq!(obscura_render::circle_of_confusion(2.0, 2.0, 0.1, 100.0)?, 0.0);
+/// # Ok::<(), obscura_render::RenderError>(())
+/// ```
 pub fn circle_of_confusion(
     depth: f32,
     focal_distance: f32,
