@@ -46,6 +46,7 @@ pub use obscura_shade as shade;
 pub use obscura_space as space;
 
 pub mod gallery;
+pub mod sky;
 
 /// The README's examples, compiled and run as doctests so they stay true.
 #[cfg(doctest)]

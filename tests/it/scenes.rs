@@ -325,3 +325,41 @@ fn images_are_identical_for_one_and_two_threads() {
             .all(|(a, b)| a.map(f32::to_bits) == b.map(f32::to_bits))
     );
 }
+
+#[test]
+fn the_shipped_sky_is_what_its_generator_makes() {
+    // scenes/sky.exr must be reproducible from the code that documents how it was made.
+    let (shipped, _) =
+        obscura_render::read_exr(&super::root().join("scenes").join("sky.exr")).unwrap();
+    let made = camera_obscura::sky::procedural_sky(
+        camera_obscura::sky::SKY_WIDTH,
+        camera_obscura::sky::SKY_HEIGHT,
+    );
+    assert_eq!((shipped.width, shipped.height), (made.width, made.height));
+    assert!(
+        shipped
+            .pixels
+            .iter()
+            .zip(&made.pixels)
+            .all(|(a, b)| a.map(f32::to_bits) == b.map(f32::to_bits))
+    );
+    // The sun is where sun_direction() says: the brightest texel looks along it (within a texel).
+    let brightest = (0..made.pixels.len())
+        .max_by(|&a, &b| made.pixels[a][0].total_cmp(&made.pixels[b][0]))
+        .unwrap();
+    let (x, y) = (
+        (brightest as u32 % made.width) as f32 + 0.5,
+        (brightest as u32 / made.width) as f32 + 0.5,
+    );
+    let theta = std::f32::consts::PI * y / made.height as f32;
+    let phi = std::f32::consts::TAU * (x / made.width as f32 - 0.5);
+    let d = Vec3::new(
+        theta.sin() * phi.sin(),
+        theta.cos(),
+        theta.sin() * phi.cos(),
+    );
+    assert!(
+        d.dot(camera_obscura::sky::sun_direction()) > 4f32.to_radians().cos(),
+        "{d:?}"
+    );
+}
