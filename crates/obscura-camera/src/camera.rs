@@ -3,6 +3,7 @@
 
 use crate::error::{CameraError, finite};
 use crate::film::{FilmGeometry, Shutter, validate_near_far};
+use glam::DVec3;
 use obscura_space::{
     AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, Ray, Transform, Vector3,
     World,
@@ -271,7 +272,7 @@ pub(crate) fn to_world(pose: &Transform<World, CameraSpace>, ray: Ray<CameraSpac
     let ray = pose.ray(ray);
     let length = ray.direction.length();
     let direction = ray.direction / length;
-    if (length - 1.0).abs() <= 1e-5 {
+    if is_unit_length(length) {
         return Ray { direction, ..ray };
     }
     Ray {
@@ -299,10 +300,81 @@ pub(crate) fn differential(
     }
 }
 
-/// The camera-space ray of one film point, lens sample and time; the model's own part.
+/// The affine part of a pose, `p_world = x * p.x + y * p.y + z * p.z + eye`, in f64 so that the
+/// per-pose constants the models derive from it are rounded to f32 once.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct PoseFrame {
+    /// World image of camera +x (not necessarily unit: the pose may scale).
+    pub x: DVec3,
+    /// World image of camera +y.
+    pub y: DVec3,
+    /// World image of camera +z.
+    pub z: DVec3,
+    /// World position of the camera origin.
+    pub eye: DVec3,
+}
+
+impl PoseFrame {
+    /// The frame of an affine pose; None for a projective one (its bottom row is not
+    /// `[0 0 0 1]`), which then takes the general path.
+    #[inline]
+    pub(crate) fn of(pose: &Transform<World, CameraSpace>) -> Option<PoseFrame> {
+        let m = pose.matrix();
+        if m.row(3) != glam::Vec4::W {
+            return None;
+        }
+        Some(PoseFrame {
+            x: m.x_axis.truncate().as_dvec3(),
+            y: m.y_axis.truncate().as_dvec3(),
+            z: m.z_axis.truncate().as_dvec3(),
+            eye: m.w_axis.truncate().as_dvec3(),
+        })
+    }
+}
+
+/// True when a world-space length that should be 1 is 1 up to f32 rounding: the test
+/// [`to_world`] uses to keep a rigid pose's clip range exactly `[near, far]`.
+#[inline]
+pub(crate) fn is_unit_length(length: f32) -> bool {
+    (length - 1.0).abs() <= 1e-5
+}
+
+/// A camera model: its camera-space rays (the general path, for any pose), and a fast path
+/// that goes straight from the film to world space through constants derived once per pose
+/// (once per camera when the pose is fixed, once per ray when it moves).
+///
+/// Both paths describe the same rays; they differ only by f32 rounding. A moving camera
+/// derives its constants at the ray's time with the same function a fixed camera uses at
+/// construction, so at a keyframe's time the two give bit-identical rays.
 pub(crate) trait CameraRayModel {
+    /// Per-pose constants of the fast path.
+    type WorldMap: Copy;
+
     fn base(&self) -> &CameraBase;
+    /// The camera-space ray (the general path, used for projective poses).
     fn ray_camera(&self, p_film: Point2<Raster>, u_lens: glam::Vec2) -> Ray<CameraSpace>;
+    /// The fast path's constants for an affine pose.
+    fn world_map(&self, frame: &PoseFrame) -> Self::WorldMap;
+    /// The constants of the fixed pose, computed at construction (None when the pose moves
+    /// or is projective).
+    fn fixed_map(&self) -> Option<&Self::WorldMap>;
+    /// The world-space ray of a film point and lens sample (time 0) from the constants.
+    fn ray_world(
+        &self,
+        map: &Self::WorldMap,
+        p_film: Point2<Raster>,
+        u_lens: glam::Vec2,
+    ) -> Ray<World>;
+}
+
+/// The constants of a camera's pose if it is fixed and affine: what the cameras store at
+/// construction.
+pub(crate) fn fixed_map_of<M: CameraRayModel>(model: &M) -> Option<M::WorldMap> {
+    let pose = &model.base().world_from_camera;
+    if pose.is_animated() {
+        return None;
+    }
+    PoseFrame::of(&pose.at(0.0)).map(|frame| model.world_map(&frame))
 }
 
 /// True when every number of the sample is finite.
@@ -311,21 +383,41 @@ fn sample_is_finite(sample: &CameraSample) -> bool {
     sample.p_film.is_finite() && sample.p_lens.is_finite() && sample.time.is_finite()
 }
 
-/// [`Camera::generate_ray`] for any model: camera-space ray, time, pose, world space.
+/// Calls `rays` with the constants of the pose at `time`, or (for a projective pose) falls back
+/// to camera-space rays moved by the pose.
+#[inline]
+fn with_pose<M: CameraRayModel, R>(
+    model: &M,
+    time: f32,
+    rays: impl Fn(&dyn Fn(Point2<Raster>, glam::Vec2) -> Ray<World>) -> R,
+) -> R {
+    if let Some(map) = model.fixed_map() {
+        return rays(&|p_film, u_lens| model.ray_world(map, p_film, u_lens));
+    }
+    let pose = model.base().pose(time);
+    match PoseFrame::of(&pose) {
+        Some(frame) => {
+            let map = model.world_map(&frame);
+            rays(&|p_film, u_lens| model.ray_world(&map, p_film, u_lens))
+        }
+        None => rays(&|p_film, u_lens| to_world(&pose, model.ray_camera(p_film, u_lens))),
+    }
+}
+
+/// [`Camera::generate_ray`] for any model: time, then the world ray of the pose at that time.
 #[inline]
 pub(crate) fn generate<M: CameraRayModel>(model: &M, sample: &CameraSample) -> Option<CameraRay> {
     if !sample_is_finite(sample) {
         return None;
     }
-    let base = model.base();
-    let time = base.shutter.time_at(sample.time);
-    let mut ray_camera = model.ray_camera(sample.p_film, sample.p_lens);
-    ray_camera.time = time;
-    let pose = base.pose(time);
-    Some(CameraRay {
-        ray: to_world(&pose, ray_camera),
-        weight: 1.0,
-    })
+    let time = model.base().shutter.time_at(sample.time);
+    let mut ray = match model.fixed_map() {
+        // The common case, without the closure machinery.
+        Some(map) => model.ray_world(map, sample.p_film, sample.p_lens),
+        None => with_pose(model, time, |ray| ray(sample.p_film, sample.p_lens)),
+    };
+    ray.time = time;
+    Some(CameraRay { ray, weight: 1.0 })
 }
 
 /// [`Camera::generate_ray_differential`] for any model: the three rays share the lens sample,
@@ -338,20 +430,21 @@ pub(crate) fn generate_differential<M: CameraRayModel>(
     if !sample_is_finite(sample) {
         return None;
     }
-    let base = model.base();
-    let time = base.shutter.time_at(sample.time);
-    let pose = base.pose(time);
-    let world = |dx: f32, dy: f32| {
-        let p_film = Point2::new(sample.p_film.x + dx, sample.p_film.y + dy);
-        let mut ray_camera = model.ray_camera(p_film, sample.p_lens);
-        ray_camera.time = time;
-        to_world(&pose, ray_camera)
-    };
-    Some(differential(
-        world(0.0, 0.0),
-        world(1.0, 0.0),
-        world(0.0, 1.0),
-    ))
+    let time = model.base().shutter.time_at(sample.time);
+    with_pose(model, time, |ray| {
+        let world = |dx: f32, dy: f32| {
+            let p_film = Point2::new(sample.p_film.x + dx, sample.p_film.y + dy);
+            Ray {
+                time,
+                ..ray(p_film, sample.p_lens)
+            }
+        };
+        Some(differential(
+            world(0.0, 0.0),
+            world(1.0, 0.0),
+            world(0.0, 1.0),
+        ))
+    })
 }
 
 #[cfg(test)]

@@ -1,12 +1,13 @@
 //! The environment (equirectangular) camera.
 
 use crate::camera::{
-    Camera, CameraBase, CameraRay, CameraRayDifferential, CameraRayModel, CameraSample, generate,
-    generate_differential,
+    Camera, CameraBase, CameraRay, CameraRayDifferential, CameraRayModel, CameraSample, PoseFrame,
+    fixed_map_of, generate, generate_differential, is_unit_length,
 };
 use crate::error::CameraError;
 use crate::film::{FilmGeometry, Shutter};
 use core::f32::consts::{PI, TAU};
+use glam::{Vec2, Vec3};
 use obscura_space::{
     AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, Ray, Vector3, World,
 };
@@ -24,6 +25,21 @@ use obscura_space::{
 #[derive(Debug, Clone)]
 pub struct EnvironmentCamera {
     base: CameraBase,
+    /// Radians per raster unit: `pi / height` for theta, `2 pi / width` for phi.
+    angle_scale: Vec2,
+    /// The fast path's constants of a fixed pose.
+    fixed: Option<EnvironmentMap>,
+}
+
+/// Per-pose constants of the fast path: the world images of the camera axes, the eye, and
+/// whether the pose is rigid (then the clip range stays exactly `[near, far]`).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct EnvironmentMap {
+    x: Vec3,
+    y: Vec3,
+    z: Vec3,
+    eye: Vec3,
+    rigid: bool,
 }
 
 impl EnvironmentCamera {
@@ -31,7 +47,14 @@ impl EnvironmentCamera {
     /// shutter.
     pub fn new(base: CameraBase) -> Result<EnvironmentCamera, CameraError> {
         base.validate(false)?;
-        Ok(EnvironmentCamera { base })
+        let [width, height] = base.film.resolution().map(|r| r as f32);
+        let mut camera = EnvironmentCamera {
+            base,
+            angle_scale: Vec2::new(TAU / width, PI / height),
+            fixed: None,
+        };
+        camera.fixed = fixed_map_of(&camera);
+        Ok(camera)
     }
 
     /// The pose, shutter, film and clip range.
@@ -43,10 +66,9 @@ impl EnvironmentCamera {
     /// The camera-space unit direction of a raster position.
     #[inline]
     pub fn direction(&self, p_film: Point2<Raster>) -> Vector3<CameraSpace> {
-        let [width, height] = self.base.film.resolution().map(|r| r as f32);
         // Spherical angles of the raster position.
-        let theta = PI * p_film.y / height;
-        let phi = TAU * (p_film.x / width - 0.5);
+        let theta = self.angle_scale.y * p_film.y;
+        let phi = self.angle_scale.x * p_film.x - PI;
         let (sin_theta, cos_theta) = theta.sin_cos();
         let (sin_phi, cos_phi) = phi.sin_cos();
         Vector3::new(sin_theta * sin_phi, cos_theta, sin_theta * cos_phi)
@@ -54,6 +76,8 @@ impl EnvironmentCamera {
 }
 
 impl CameraRayModel for EnvironmentCamera {
+    type WorldMap = EnvironmentMap;
+
     #[inline]
     fn base(&self) -> &CameraBase {
         &self.base
@@ -63,6 +87,49 @@ impl CameraRayModel for EnvironmentCamera {
     fn ray_camera(&self, p_film: Point2<Raster>, _u_lens: glam::Vec2) -> Ray<CameraSpace> {
         Ray::new(Point3::ORIGIN, self.direction(p_film), 0.0)
             .with_range(self.base.near, self.base.far)
+    }
+
+    #[inline]
+    fn world_map(&self, frame: &PoseFrame) -> EnvironmentMap {
+        let (x, y, z) = (frame.x, frame.y, frame.z);
+        // Rigid: orthonormal axes up to f32 rounding (what `to_world` tests per ray).
+        let rigid = [x.length(), y.length(), z.length()]
+            .iter()
+            .all(|&l| is_unit_length(l as f32))
+            && [x.dot(y), y.dot(z), z.dot(x)]
+                .iter()
+                .all(|d| d.abs() <= 1e-5);
+        EnvironmentMap {
+            x: x.as_vec3(),
+            y: y.as_vec3(),
+            z: z.as_vec3(),
+            eye: frame.eye.as_vec3(),
+            rigid,
+        }
+    }
+
+    #[inline]
+    fn fixed_map(&self) -> Option<&EnvironmentMap> {
+        self.fixed.as_ref()
+    }
+
+    #[inline]
+    fn ray_world(&self, map: &EnvironmentMap, p_film: Point2<Raster>, _u_lens: Vec2) -> Ray<World> {
+        let d_camera = self.direction(p_film);
+        let w = map.x * d_camera.x + map.y * d_camera.y + map.z * d_camera.z;
+        let length = w.length();
+        let (t_min, t_max) = if map.rigid {
+            (self.base.near, self.base.far)
+        } else {
+            (self.base.near * length, self.base.far * length)
+        };
+        Ray {
+            origin: Point3::from_glam(map.eye),
+            direction: Vector3::from_glam(w / length),
+            time: 0.0,
+            t_min,
+            t_max,
+        }
     }
 }
 

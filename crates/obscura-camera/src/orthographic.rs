@@ -1,12 +1,13 @@
 //! The orthographic camera, pinhole or thin lens.
 
 use crate::camera::{
-    Camera, CameraBase, CameraRay, CameraRayDifferential, CameraRayModel, CameraSample, ThinLens,
-    generate, generate_differential,
+    Camera, CameraBase, CameraRay, CameraRayDifferential, CameraRayModel, CameraSample, PoseFrame,
+    ThinLens, fixed_map_of, generate, generate_differential, is_unit_length,
 };
 use crate::error::CameraError;
 use crate::film::{FilmGeometry, Shutter};
 use crate::projective::{ProjectiveCamera, from_rows};
+use glam::{Vec2, Vec3};
 use obscura_space::{
     AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, Ray, Vector3, World,
 };
@@ -30,6 +31,26 @@ use obscura_space::{
 #[derive(Debug, Clone)]
 pub struct OrthographicCamera {
     projective: ProjectiveCamera,
+    /// The fast path's constants of a fixed pose.
+    fixed: Option<OrthographicMap>,
+}
+
+/// Per-pose constants of the fast path. The film point's ray starts at world
+/// `eye + R (x', y', 0) = o_x * x + o_y * y + o_1` (affine in raster x, y) and runs along `R z`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct OrthographicMap {
+    o_x: Vec3,
+    o_y: Vec3,
+    o_1: Vec3,
+    /// World images of camera +x, +y and +z.
+    lens_x: Vec3,
+    lens_y: Vec3,
+    axis: Vec3,
+    /// `axis` normalised, and the distances to camera z = near and far along it: exactly
+    /// `[near, far]` when the pose is rigid (`|axis|` is 1 up to rounding).
+    direction: Vec3,
+    t_min: f32,
+    t_max: f32,
 }
 
 impl OrthographicCamera {
@@ -52,7 +73,12 @@ impl OrthographicCamera {
         ]);
         let projective =
             ProjectiveCamera::build(base, lens, (screen_from_camera, camera_from_screen), false)?;
-        Ok(OrthographicCamera { projective })
+        let mut camera = OrthographicCamera {
+            projective,
+            fixed: None,
+        };
+        camera.fixed = fixed_map_of(&camera);
+        Ok(camera)
     }
 
     /// The projective chain (screen, NDC and raster transforms).
@@ -68,6 +94,8 @@ impl OrthographicCamera {
 }
 
 impl CameraRayModel for OrthographicCamera {
+    type WorldMap = OrthographicMap;
+
     #[inline]
     fn base(&self) -> &CameraBase {
         self.projective.base()
@@ -83,6 +111,67 @@ impl CameraRayModel for OrthographicCamera {
             self.projective.through_lens(p_origin, d_camera, u_lens)
         } else {
             self.projective.clipped(p_origin, d_camera)
+        }
+    }
+
+    #[inline]
+    fn world_map(&self, frame: &PoseFrame) -> OrthographicMap {
+        let base = self.projective.base();
+        // Film to camera (x', y', 0) in world units, then eye + x' R.x + y' R.y.
+        let (scale, offset) = self.projective.screen_from_raster_xy();
+        let axis = frame.z.as_vec3();
+        let length = axis.length();
+        let (t_min, t_max) = if is_unit_length(length) {
+            (base.near, base.far)
+        } else {
+            (base.near * length, base.far * length)
+        };
+        OrthographicMap {
+            o_x: (frame.x * scale.x).as_vec3(),
+            o_y: (frame.y * scale.y).as_vec3(),
+            o_1: (frame.eye + frame.x * offset.x + frame.y * offset.y).as_vec3(),
+            lens_x: frame.x.as_vec3(),
+            lens_y: frame.y.as_vec3(),
+            axis,
+            direction: axis / length,
+            t_min,
+            t_max,
+        }
+    }
+
+    #[inline]
+    fn fixed_map(&self) -> Option<&OrthographicMap> {
+        self.fixed.as_ref()
+    }
+
+    #[inline]
+    fn ray_world(&self, map: &OrthographicMap, p_film: Point2<Raster>, u_lens: Vec2) -> Ray<World> {
+        let lens = self.projective.lens();
+        let p_center = map.o_x * p_film.x + map.o_y * p_film.y + map.o_1;
+        if !lens.is_thin_lens() {
+            return Ray {
+                origin: Point3::from_glam(p_center),
+                direction: Vector3::from_glam(map.direction),
+                time: 0.0,
+                t_min: map.t_min,
+                t_max: map.t_max,
+            };
+        }
+        // Thin lens: from the lens point p_center + R (a.x, a.y, 0) to the focus point
+        // p_center + focal_distance R z: direction R (-a.x, -a.y, focal_distance), whose camera
+        // z is focal_distance, so camera z = near is at distance near * len / focal_distance.
+        let base = self.projective.base();
+        let a = lens.aperture_point(u_lens);
+        let offset = map.lens_x * a.x + map.lens_y * a.y;
+        let v = map.axis * lens.focal_distance - offset;
+        let length = v.length();
+        let per_z = length / lens.focal_distance;
+        Ray {
+            origin: Point3::from_glam(p_center + offset),
+            direction: Vector3::from_glam(v / length),
+            time: 0.0,
+            t_min: base.near * per_z,
+            t_max: base.far * per_z,
         }
     }
 }

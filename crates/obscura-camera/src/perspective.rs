@@ -1,13 +1,16 @@
 //! The perspective camera, pinhole or thin lens.
 
 use crate::camera::{
-    Camera, CameraBase, CameraRay, CameraRayDifferential, CameraRayModel, CameraSample, ThinLens,
-    generate, generate_differential,
+    Camera, CameraBase, CameraRay, CameraRayDifferential, CameraRayModel, CameraSample, PoseFrame,
+    ThinLens, fixed_map_of, generate, generate_differential,
 };
 use crate::error::{CameraError, finite};
 use crate::film::{FilmGeometry, FovAxis, Shutter};
 use crate::projective::{ProjectiveCamera, from_rows};
-use obscura_space::{AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, Ray, World};
+use glam::{Vec2, Vec3};
+use obscura_space::{
+    AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, Ray, Vector3, World,
+};
 
 /// A perspective camera: the projection plane at camera z = 1 scaled so that the field of view
 /// spans the screen window's half-extent along [`FovAxis`]; rays from the eye (or, with a thin
@@ -31,6 +34,29 @@ pub struct PerspectiveCamera {
     projective: ProjectiveCamera,
     fov_degrees: f32,
     fov_axis: FovAxis,
+    /// `1 / s`: screen x and y over it are the camera x and y of the film point on z = 1.
+    plane_from_screen: f64,
+    /// The fast path's constants of a fixed pose.
+    fixed: Option<PerspectiveMap>,
+}
+
+/// Per-pose constants of the fast path. With `q = (x', y', 1)` the film point on the camera
+/// plane z = 1 (affine in raster x, y) and `R` the pose's linear part, the world direction
+/// through the lens centre is `R q = d_x * x + d_y * y + d_1`: one 3x3 map folded with the
+/// film-to-plane map, instead of a 4x4 projective map with a divide and a pose transform.
+///
+/// The clip range follows without a divide: camera z along `R q` grows by exactly 1 per unit
+/// of `R q`, so with `len = |R q|` the points at camera z = near and far are at distances
+/// `near * len` and `far * len` along the unit direction (for any affine pose, scaled or not).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct PerspectiveMap {
+    d_x: Vec3,
+    d_y: Vec3,
+    d_1: Vec3,
+    eye: Vec3,
+    /// World images of camera +x and +y: the aperture's axes.
+    lens_x: Vec3,
+    lens_y: Vec3,
 }
 
 impl PerspectiveCamera {
@@ -70,11 +96,15 @@ impl PerspectiveCamera {
         ]);
         let projective =
             ProjectiveCamera::build(base, lens, (screen_from_camera, camera_from_screen), true)?;
-        Ok(PerspectiveCamera {
+        let mut camera = PerspectiveCamera {
             projective,
             fov_degrees,
             fov_axis,
-        })
+            plane_from_screen: 1.0 / scale,
+            fixed: None,
+        };
+        camera.fixed = fixed_map_of(&camera);
+        Ok(camera)
     }
 
     /// The projective chain (screen, NDC and raster transforms).
@@ -100,6 +130,8 @@ impl PerspectiveCamera {
 }
 
 impl CameraRayModel for PerspectiveCamera {
+    type WorldMap = PerspectiveMap;
+
     #[inline]
     fn base(&self) -> &CameraBase {
         self.projective.base()
@@ -115,6 +147,63 @@ impl CameraRayModel for PerspectiveCamera {
                 .through_lens(Point3::ORIGIN, d_camera, u_lens)
         } else {
             self.projective.clipped(Point3::ORIGIN, d_camera)
+        }
+    }
+
+    #[inline]
+    fn world_map(&self, frame: &PoseFrame) -> PerspectiveMap {
+        // Film to the plane z = 1: q = (screen x, screen y) / s, then R q = x' R.x + y' R.y + R.z.
+        let (scale, offset) = self.projective.screen_from_raster_xy();
+        let (scale, offset) = (
+            scale * self.plane_from_screen,
+            offset * self.plane_from_screen,
+        );
+        PerspectiveMap {
+            d_x: (frame.x * scale.x).as_vec3(),
+            d_y: (frame.y * scale.y).as_vec3(),
+            d_1: (frame.x * offset.x + frame.y * offset.y + frame.z).as_vec3(),
+            eye: frame.eye.as_vec3(),
+            lens_x: frame.x.as_vec3(),
+            lens_y: frame.y.as_vec3(),
+        }
+    }
+
+    #[inline]
+    fn fixed_map(&self) -> Option<&PerspectiveMap> {
+        self.fixed.as_ref()
+    }
+
+    #[inline]
+    fn ray_world(&self, map: &PerspectiveMap, p_film: Point2<Raster>, u_lens: Vec2) -> Ray<World> {
+        let base = self.projective.base();
+        let lens = self.projective.lens();
+        // The direction through the lens centre, R q (camera z 1 per unit).
+        let w = map.d_x * p_film.x + map.d_y * p_film.y + map.d_1;
+        if !lens.is_thin_lens() {
+            let length = w.length();
+            return Ray {
+                origin: Point3::from_glam(map.eye),
+                direction: Vector3::from_glam(w / length),
+                time: 0.0,
+                t_min: base.near * length,
+                t_max: base.far * length,
+            };
+        }
+        // Thin lens: the centre ray reaches the plane of focus at eye + focal_distance * R q;
+        // the sample ray goes there from the lens point eye + R (a.x, a.y, 0). Its direction
+        // R (focal_distance q - a) has camera z focal_distance, so camera z = near is at
+        // distance near * len / focal_distance along the unit direction.
+        let a = lens.aperture_point(u_lens);
+        let offset = map.lens_x * a.x + map.lens_y * a.y;
+        let v = w * lens.focal_distance - offset;
+        let length = v.length();
+        let per_z = length / lens.focal_distance;
+        Ray {
+            origin: Point3::from_glam(map.eye + offset),
+            direction: Vector3::from_glam(v / length),
+            time: 0.0,
+            t_min: base.near * per_z,
+            t_max: base.far * per_z,
         }
     }
 }

@@ -3,7 +3,7 @@
 
 use crate::camera::{CameraBase, ThinLens};
 use crate::error::CameraError;
-use glam::{DMat4, DVec3};
+use glam::{DMat4, DVec2, DVec3};
 use obscura_space::{
     Camera as CameraSpace, Ndc, Point2, Point3, Raster, Ray, Screen, Transform, Vector3,
 };
@@ -28,6 +28,7 @@ pub struct ProjectiveCamera {
     raster_from_ndc: Transform<Raster, Ndc>,
     raster_from_screen: Transform<Raster, Screen>,
     camera_from_raster: Transform<CameraSpace, Raster>,
+    screen_from_raster_xy: (DVec2, DVec2),
 }
 
 /// Rows written as a matrix is printed, for readability of the closed forms.
@@ -93,6 +94,10 @@ impl ProjectiveCamera {
             raster_from_ndc: typed(raster_from_ndc, ndc_from_raster),
             raster_from_screen: typed(raster_from_screen, screen_from_raster),
             camera_from_raster: typed(camera_from_raster, raster_from_camera),
+            screen_from_raster_xy: (
+                DVec2::new(dx / width, -dy / height),
+                DVec2::new(x_min, y_max),
+            ),
         })
     }
 
@@ -171,6 +176,14 @@ impl ProjectiveCamera {
     #[inline]
     pub fn raster_from_camera(&self) -> Transform<Raster, CameraSpace> {
         self.camera_from_raster.inverse()
+    }
+
+    /// Screen x and y of a raster position as `scale * p_raster + offset`, in f64: `(scale,
+    /// offset)`. Both models' fast paths start from it (screen z does not enter: the map is
+    /// affine in x and y).
+    #[inline]
+    pub(crate) fn screen_from_raster_xy(&self) -> (DVec2, DVec2) {
+        self.screen_from_raster_xy
     }
 
     /// The film point of a raster position in camera space, on the near plane (screen z = 0).
