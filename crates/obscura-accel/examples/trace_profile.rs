@@ -1,0 +1,139 @@
+//! A deterministic traversal workload for instruction-count profiling (valgrind's callgrind):
+//! builds a displaced grid of 2 * 300^2 = 180,000 triangles, then traces the same 65,536
+//! coherent primary and 65,536 incoherent random rays as closest-hit and as shadow queries,
+//! each in its own non-inlined function so `callgrind_annotate --inclusive=yes` gives per-query
+//! instruction counts.
+//!
+//! ```text
+//! cargo build --release -p obscura-accel --example trace_profile
+//! valgrind --tool=callgrind --callgrind-out-file=cg.out target/release/examples/trace_profile
+//! ```
+//!
+//! For one figure per query, split the profile at each of them with `--dump-after=` for
+//! `trace_profile::setup_done`, `trace_profile::closest_*` and `trace_profile::shadow_*`: the
+//! `totals:` line of each part is then that query's count (`--cache-sim=yes` adds cache misses).
+//!
+//! Pass `icosphere` as the first argument for a 20 * 4^7 = 327,680-triangle sphere instead
+//! (`grid` for the default), and `fast`, `medium` (the default) or `slow` as the second for the
+//! [`BuildQuality`].
+
+use obscura_accel::{BuildQuality, Placement, Scene, SceneBuilder, Shape, testmesh};
+use obscura_space::{Point3, Ray, Transform, Vector3, World};
+use std::hint::black_box;
+use std::sync::Arc;
+
+/// A 256 x 256 pinhole grid from (0, 0, 3) looking down -z over a 60-degree field.
+fn primary_rays() -> Vec<Ray<World>> {
+    let n = 256;
+    let half = (30.0f32).to_radians().tan();
+    let mut rays = Vec::with_capacity(n * n);
+    for j in 0..n {
+        for i in 0..n {
+            let x = ((i as f32 + 0.5) / n as f32 * 2.0 - 1.0) * half;
+            let y = (1.0 - (j as f32 + 0.5) / n as f32 * 2.0) * half;
+            let d = Vector3::new(x, y, -1.0).normalize();
+            rays.push(Ray::new(Point3::new(0.0, 0.0, 3.0), d, 0.0));
+        }
+    }
+    rays
+}
+
+/// 65,536 rays from random points on a sphere of radius 3 towards random points in the unit
+/// cube (a fixed xorshift sequence).
+fn random_rays() -> Vec<Ray<World>> {
+    let mut state = 0x2545_F491_4F6C_DD1Du64;
+    let mut u = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 40) as f32 / (1u64 << 24) as f32
+    };
+    (0..65_536)
+        .map(|_| {
+            let on_sphere = loop {
+                let v = Vector3::<World>::new(2.0 * u() - 1.0, 2.0 * u() - 1.0, 2.0 * u() - 1.0);
+                let l = v.length();
+                if l > 0.1 && l <= 1.0 {
+                    break v * (3.0 / l);
+                }
+            };
+            let origin = Point3::ORIGIN + on_sphere;
+            let target = Point3::new(2.0 * u() - 1.0, 2.0 * u() - 1.0, 2.0 * u() - 1.0);
+            Ray::new(origin, (target - origin).normalize(), 0.0)
+        })
+        .collect()
+}
+
+#[inline(never)]
+fn closest_primary(scene: &Scene, rays: &[Ray<World>]) -> f64 {
+    closest(scene, rays) + 1.0
+}
+
+#[inline(never)]
+fn closest_random(scene: &Scene, rays: &[Ray<World>]) -> f64 {
+    closest(scene, rays) + 2.0
+}
+
+#[inline(never)]
+fn shadow_primary(scene: &Scene, rays: &[Ray<World>]) -> usize {
+    rays.iter().filter(|r| scene.occluded(r)).count() + 1
+}
+
+#[inline(never)]
+fn shadow_random(scene: &Scene, rays: &[Ray<World>]) -> usize {
+    rays.iter().filter(|r| scene.occluded(r)).count() + 2
+}
+
+/// Marks the end of the set-up, for `--dump-after=trace_profile::setup_done`.
+#[inline(never)]
+fn setup_done(scene: &Scene) {
+    black_box(scene.bounds());
+}
+
+/// (Each query function adds its own constant so the linker cannot fold them into one.)
+/// Sums t and the primitive ids so the hits cannot be optimised away and runs can be compared.
+fn closest(scene: &Scene, rays: &[Ray<World>]) -> f64 {
+    rays.iter()
+        .filter_map(|r| scene.intersect(r))
+        .map(|h| f64::from(h.t) + f64::from(h.primitive) + f64::from(h.n_shading.to_glam().x))
+        .sum()
+}
+
+fn main() {
+    let mesh = match std::env::args().nth(1).as_deref() {
+        Some("icosphere") => testmesh::icosphere(7),
+        _ => testmesh::displaced_grid(300),
+    }
+    .expect("generated meshes are valid");
+    let quality = match std::env::args().nth(2).as_deref() {
+        Some("fast") => BuildQuality::Fast,
+        Some("slow") => BuildQuality::Slow,
+        _ => BuildQuality::Medium,
+    };
+    let mut builder = SceneBuilder::new().with_quality(quality);
+    builder
+        .add(
+            Shape::Mesh(Arc::new(mesh)),
+            Placement::Static(Transform::IDENTITY),
+        )
+        .expect("a static identity placement is valid");
+    let scene = builder.build().expect("one mesh builds");
+    let (primary, random) = (primary_rays(), random_rays());
+    setup_done(&scene);
+    println!(
+        "closest primary {:.3}",
+        black_box(closest_primary(&scene, &primary))
+    );
+    println!(
+        "closest random {:.3}",
+        black_box(closest_random(&scene, &random))
+    );
+    println!(
+        "shadow primary {}",
+        black_box(shadow_primary(&scene, &primary))
+    );
+    println!(
+        "shadow random {}",
+        black_box(shadow_random(&scene, &random))
+    );
+}
