@@ -318,8 +318,7 @@ impl PoseFrame {
     /// The frame of an affine pose; None for a projective one (its bottom row is not
     /// `[0 0 0 1]`), which then takes the general path.
     #[inline]
-    pub(crate) fn of(pose: &Transform<World, CameraSpace>) -> Option<PoseFrame> {
-        let m = pose.matrix();
+    pub(crate) fn of(m: glam::Mat4) -> Option<PoseFrame> {
         if m.row(3) != glam::Vec4::W {
             return None;
         }
@@ -374,7 +373,7 @@ pub(crate) fn fixed_map_of<M: CameraRayModel>(model: &M) -> Option<M::WorldMap> 
     if pose.is_animated() {
         return None;
     }
-    PoseFrame::of(&pose.at(0.0)).map(|frame| model.world_map(&frame))
+    PoseFrame::of(pose.matrix_at(0.0)).map(|frame| model.world_map(&frame))
 }
 
 /// True when every number of the sample is finite.
@@ -394,13 +393,17 @@ fn with_pose<M: CameraRayModel, R>(
     if let Some(map) = model.fixed_map() {
         return rays(&|p_film, u_lens| model.ray_world(map, p_film, u_lens));
     }
-    let pose = model.base().pose(time);
-    match PoseFrame::of(&pose) {
+    // Only the forward matrix: a moving pose skips the interpolated inverse.
+    let world_from_camera = &model.base().world_from_camera;
+    match PoseFrame::of(world_from_camera.matrix_at(time)) {
         Some(frame) => {
             let map = model.world_map(&frame);
             rays(&|p_film, u_lens| model.ray_world(&map, p_film, u_lens))
         }
-        None => rays(&|p_film, u_lens| to_world(&pose, model.ray_camera(p_film, u_lens))),
+        None => {
+            let pose = model.base().pose(time);
+            rays(&|p_film, u_lens| to_world(&pose, model.ray_camera(p_film, u_lens)))
+        }
     }
 }
 

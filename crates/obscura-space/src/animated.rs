@@ -32,7 +32,58 @@ pub struct AnimatedTransform<To: Space, From: Space> {
     times: Vec<f32>,
     keys: Vec<Transform<To, From>>,
     parts: Vec<Decomposed>,
+    /// Per segment between neighbouring keyframes: the constants `at` would otherwise
+    /// recompute for every call.
+    segments: Vec<Segment>,
     animated: bool,
+}
+
+/// Constants of the segment between two decomposed keyframes `a` and `z`, computed once.
+#[derive(Clone, Copy, Debug)]
+struct Segment {
+    /// The angle `theta` between the two rotation quaternions (half the rotation angle);
+    /// `1 / sin(theta)`, or 0 when the rotations coincide (sin(theta) < 1e-12) and the
+    /// quaternions are interpolated linearly instead.
+    theta: f64,
+    inv_sin_theta: f64,
+    /// The stretch and its inverse when both keyframes have the same stretch up to the f32
+    /// rounding of their matrices (a rigid motion: every look-at): their mean, so `at` needs
+    /// neither the blend nor a 3x3 inverse per call.
+    constant_stretch: Option<(DMat3, DMat3)>,
+}
+
+/// The mean of two stretches that agree to within f32 rounding (relative 2^-24 of the largest
+/// entry), with its inverse; None otherwise. Replacing the linear blend by the mean moves the
+/// interpolated matrix by at most that difference, below the rounding of the f32 result; at
+/// the keyframes' own times `at` returns the keyframes as given anyway.
+fn constant_stretch(a: &DMat3, z: &DMat3) -> Option<(DMat3, DMat3)> {
+    let size = a.abs().to_cols_array().into_iter().fold(0.0, f64::max);
+    let gap = (*z - *a)
+        .abs()
+        .to_cols_array()
+        .into_iter()
+        .fold(0.0, f64::max);
+    if gap > size * f64::from(f32::EPSILON) * 0.5 {
+        return None;
+    }
+    let mean = (*a + *z) * 0.5;
+    Some((mean, mean.inverse()))
+}
+
+impl Segment {
+    fn new(a: &Decomposed, z: &Decomposed) -> Segment {
+        let theta = a.rotation.dot(z.rotation).clamp(-1.0, 1.0).acos();
+        let sin_theta = theta.sin();
+        Segment {
+            theta,
+            inv_sin_theta: if sin_theta < 1e-12 {
+                0.0
+            } else {
+                1.0 / sin_theta
+            },
+            constant_stretch: constant_stretch(&a.stretch, &z.stretch),
+        }
+    }
 }
 
 impl<To: Space, From: Space> AnimatedTransform<To, From> {
@@ -42,6 +93,7 @@ impl<To: Space, From: Space> AnimatedTransform<To, From> {
             times: vec![0.0],
             keys: vec![t],
             parts: Vec::new(),
+            segments: Vec::new(),
             animated: false,
         }
     }
@@ -83,6 +135,7 @@ impl<To: Space, From: Space> AnimatedTransform<To, From> {
                 times: vec![times[0]],
                 keys: vec![keys[0]],
                 parts: Vec::new(),
+                segments: Vec::new(),
                 animated,
             });
         }
@@ -104,10 +157,15 @@ impl<To: Space, From: Space> AnimatedTransform<To, From> {
                 parts[i].rotation = -parts[i].rotation;
             }
         }
+        let segments = parts
+            .windows(2)
+            .map(|w| Segment::new(&w[0], &w[1]))
+            .collect();
         Ok(Self {
             times,
             keys,
             parts,
+            segments,
             animated,
         })
     }
@@ -138,21 +196,48 @@ impl<To: Space, From: Space> AnimatedTransform<To, From> {
     /// The transform at `time`: a keyframe exactly at its own time, before the first and after
     /// the last; interpolated in between.
     pub fn at(&self, time: f32) -> Transform<To, From> {
+        match self.locate(time) {
+            Ok(k) => self.keys[k],
+            Err((k, u)) => {
+                let (linear, translation, stretch_inverse, rot) =
+                    interpolate_parts(&self.parts[k], &self.parts[k + 1], &self.segments[k], u);
+                let (m, m_inv) = matrices(linear, translation, stretch_inverse, rot);
+                Transform::from_matrix_and_inverse(m.as_mat4(), m_inv.as_mat4())
+            }
+        }
+    }
+
+    /// The matrix of [`AnimatedTransform::at`] alone, bit for bit `at(time).matrix()`, without
+    /// the work of the inverse: for per-sample callers that only map forwards (camera rays).
+    pub fn matrix_at(&self, time: f32) -> Mat4 {
+        match self.locate(time) {
+            Ok(k) => self.keys[k].matrix(),
+            Err((k, u)) => {
+                let (linear, translation, _, _) =
+                    interpolate_parts(&self.parts[k], &self.parts[k + 1], &self.segments[k], u);
+                DMat4::from_mat3_translation(linear, translation).as_mat4()
+            }
+        }
+    }
+
+    /// Where `time` falls: `Ok(k)` for keyframe `k` as given (at its own time, before the first,
+    /// after the last, or a fixed transform), `Err((k, u))` for fraction `u` into segment `k`.
+    #[inline]
+    fn locate(&self, time: f32) -> Result<usize, (usize, f64)> {
         if !self.animated || time.is_nan() || time <= self.times[0] {
-            return self.keys[0];
+            return Ok(0);
         }
         let last = self.times.len() - 1;
         if time >= self.times[last] {
-            return self.keys[last];
+            return Ok(last);
         }
         // The segment [times[k], times[k + 1]) holding `time`.
         let k = self.times.partition_point(|&t| t <= time) - 1;
         if time == self.times[k] {
-            return self.keys[k];
+            return Ok(k);
         }
         let u = f64::from(time - self.times[k]) / f64::from(self.times[k + 1] - self.times[k]);
-        let (m, m_inv) = interpolate(&self.parts[k], &self.parts[k + 1], u);
-        Transform::from_matrix_and_inverse(m.as_mat4(), m_inv.as_mat4())
+        Err((k, u))
     }
 
     /// Maps a point as it is at `time`.
@@ -186,15 +271,17 @@ impl<To: Space, From: Space> AnimatedTransform<To, From> {
         let mut lo = DVec3::INFINITY;
         let mut hi = DVec3::NEG_INFINITY;
         let mut grow = 0.0f64;
-        for (a, z) in self.parts.iter().zip(&self.parts[1..]) {
-            let theta = 2.0 * a.rotation.dot(z.rotation).abs().min(1.0).acos();
+        for ((a, z), segment) in self.parts.iter().zip(&self.parts[1..]).zip(&self.segments) {
+            let theta = 2.0 * segment.theta;
             let steps = if theta < 1e-9 {
                 1
             } else {
                 (theta * 20.0).ceil().max(2.0) as usize
             };
             for i in 0..=steps {
-                let (m, _) = interpolate(a, z, i as f64 / steps as f64);
+                let (linear, translation, _, _) =
+                    interpolate_parts(a, z, segment, i as f64 / steps as f64);
+                let m = DMat4::from_mat3_translation(linear, translation);
                 for c in &corners {
                     let p = m.transform_point3(*c);
                     lo = lo.min(p);
@@ -264,16 +351,47 @@ fn decompose(m: Mat4) -> Result<Decomposed, SpaceError> {
     })
 }
 
-/// The matrix and its inverse at fraction `u` between two decomposed keyframes.
-fn interpolate(a: &Decomposed, z: &Decomposed, u: f64) -> (DMat4, DMat4) {
+/// The parts of the transform at fraction `u` between two decomposed keyframes, with the
+/// segment's constants: the linear part `R S`, the translation, `S^-1` and `R`.
+#[inline]
+fn interpolate_parts(
+    a: &Decomposed,
+    z: &Decomposed,
+    segment: &Segment,
+    u: f64,
+) -> (DMat3, DVec3, DMat3, DMat3) {
     let translation = a.translation.lerp(z.translation, u);
-    let rotation = a.rotation.slerp(z.rotation, u);
-    let stretch = a.stretch * (1.0 - u) + z.stretch * u;
+    // Slerp with the angle and 1 / sin(theta) of the segment (the quaternions are in the same
+    // hemisphere): (sin((1 - u) theta) a + sin(u theta) z) / sin(theta); coinciding rotations
+    // interpolate linearly.
+    let rotation = if segment.inv_sin_theta == 0.0 {
+        a.rotation.lerp(z.rotation, u).normalize()
+    } else {
+        let wa = ((1.0 - u) * segment.theta).sin() * segment.inv_sin_theta;
+        let wz = (u * segment.theta).sin() * segment.inv_sin_theta;
+        a.rotation * wa + z.rotation * wz
+    };
     let rot = DMat3::from_quat(rotation);
-    let linear = rot * stretch;
+    let (stretch, stretch_inverse) = match segment.constant_stretch {
+        Some(pair) => pair,
+        None => {
+            let stretch = a.stretch * (1.0 - u) + z.stretch * u;
+            (stretch, stretch.inverse())
+        }
+    };
+    (rot * stretch, translation, stretch_inverse, rot)
+}
+
+/// The matrix `T R S` and its inverse from the parts of [`interpolate_parts`].
+fn matrices(
+    linear: DMat3,
+    translation: DVec3,
+    stretch_inverse: DMat3,
+    rot: DMat3,
+) -> (DMat4, DMat4) {
     let m = DMat4::from_mat3_translation(linear, translation);
     // (T R S)^-1 = S^-1 R^T T^-1.
-    let linear_inv = stretch.inverse() * rot.transpose();
+    let linear_inv = stretch_inverse * rot.transpose();
     let m_inv = DMat4::from_mat3_translation(linear_inv, -(linear_inv * translation));
     (m, m_inv)
 }
@@ -284,6 +402,7 @@ impl<To: Space, From: Space> Clone for AnimatedTransform<To, From> {
             times: self.times.clone(),
             keys: self.keys.clone(),
             parts: self.parts.clone(),
+            segments: self.segments.clone(),
             animated: self.animated,
         }
     }

@@ -36,6 +36,33 @@ proptest! {
         prop_assert_eq!(anim.at(t1 + 1.0), b);
     }
 
+    /// The forward-only `matrix_at` is `at(time).matrix()` bit for bit, at keyframes, between
+    /// them and outside, and the interpolated inverse inverts (scaled keyframes included).
+    #[test]
+    fn matrix_at_is_the_matrix_of_at(a in trs(), b in trs(), c in trs(), t in -0.5f32..2.5) {
+        let anim = AnimatedTransform::from_keyframes(vec![(0.0, a), (1.0, b), (2.0, c)]).unwrap();
+        for time in [t, 0.0, 1.0, 2.0] {
+            prop_assert_eq!(anim.matrix_at(time), anim.at(time).matrix());
+        }
+        let m = anim.at(t);
+        let residual = m.matrix() * m.inverse_matrix() - glam::Mat4::IDENTITY;
+        prop_assert!(residual.to_cols_array().iter().all(|r| r.abs() < 1e-4), "{residual:?}");
+    }
+
+    /// A turn about one axis from angle `a0` to `a1` (less than half a turn apart, so slerp
+    /// takes this way round) is the rotation by `a0 + u (a1 - a0)` at fraction `u`: the
+    /// slerp's cached angle and 1 / sin(angle) against the closed form.
+    #[test]
+    fn slerp_turns_at_constant_speed(a0 in -180f32..180.0, turn in -179f32..179.0, u in 0f32..1.0) {
+        let axis = glam::Vec3::new(0.3, -0.5, 0.8);
+        let start = Wo::rotate(a0, axis).unwrap();
+        let end = Wo::rotate(a0 + turn, axis).unwrap();
+        let anim = AnimatedTransform::new(start, 0.0, end, 1.0).unwrap();
+        let want = Wo::rotate(a0 + u * turn, axis).unwrap().matrix();
+        let got = anim.at(u).matrix();
+        prop_assert!((got - want).to_cols_array().iter().all(|d| d.abs() < 2e-5), "{got:?} != {want:?}");
+    }
+
     #[test]
     fn rigid_keyframes_give_rigid_motion(a in rigid(), b in rigid(), u in 0.0f32..1.0) {
         let anim = AnimatedTransform::new(a, 0.0, b, 1.0).unwrap();
