@@ -7,7 +7,7 @@ use crate::camera::{
 use crate::error::CameraError;
 use crate::film::{FilmGeometry, Shutter};
 use core::f32::consts::{PI, TAU};
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec3A};
 use obscura_space::{
     AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, Ray, Vector3, World,
 };
@@ -35,10 +35,10 @@ pub struct EnvironmentCamera {
 /// whether the pose is rigid (then the clip range stays exactly `[near, far]`).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct EnvironmentMap {
-    x: Vec3,
-    y: Vec3,
-    z: Vec3,
-    eye: Vec3,
+    x: Vec3A,
+    y: Vec3A,
+    z: Vec3A,
+    eye: Vec3A,
     rigid: bool,
 }
 
@@ -100,10 +100,10 @@ impl CameraRayModel for EnvironmentCamera {
                 .iter()
                 .all(|d| d.abs() <= 1e-5);
         EnvironmentMap {
-            x: x.as_vec3(),
-            y: y.as_vec3(),
-            z: z.as_vec3(),
-            eye: frame.eye.as_vec3(),
+            x: x.as_vec3().into(),
+            y: y.as_vec3().into(),
+            z: z.as_vec3().into(),
+            eye: frame.eye.as_vec3().into(),
             rigid,
         }
     }
@@ -124,8 +124,8 @@ impl CameraRayModel for EnvironmentCamera {
             (self.base.near * length, self.base.far * length)
         };
         Ray {
-            origin: Point3::from_glam(map.eye),
-            direction: Vector3::from_glam(w / length),
+            origin: Point3::from_glam(Vec3::from(map.eye)),
+            direction: Vector3::from_glam(Vec3::from(w / length)),
             time: 0.0,
             t_min,
             t_max,

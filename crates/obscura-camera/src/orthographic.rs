@@ -7,7 +7,7 @@ use crate::camera::{
 use crate::error::CameraError;
 use crate::film::{FilmGeometry, Shutter};
 use crate::projective::{ProjectiveCamera, from_rows};
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec3A};
 use obscura_space::{
     AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, Ray, Vector3, World,
 };
@@ -39,16 +39,16 @@ pub struct OrthographicCamera {
 /// `eye + R (x', y', 0) = o_x * x + o_y * y + o_1` (affine in raster x, y) and runs along `R z`.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct OrthographicMap {
-    o_x: Vec3,
-    o_y: Vec3,
-    o_1: Vec3,
+    o_x: Vec3A,
+    o_y: Vec3A,
+    o_1: Vec3A,
     /// World images of camera +x, +y and +z.
-    lens_x: Vec3,
-    lens_y: Vec3,
-    axis: Vec3,
+    lens_x: Vec3A,
+    lens_y: Vec3A,
+    axis: Vec3A,
     /// `axis` normalised, and the distances to camera z = near and far along it: exactly
     /// `[near, far]` when the pose is rigid (`|axis|` is 1 up to rounding).
-    direction: Vec3,
+    direction: Vec3A,
     t_min: f32,
     t_max: f32,
 }
@@ -119,7 +119,7 @@ impl CameraRayModel for OrthographicCamera {
         let base = self.projective.base();
         // Film to camera (x', y', 0) in world units, then eye + x' R.x + y' R.y.
         let (scale, offset) = self.projective.screen_from_raster_xy();
-        let axis = frame.z.as_vec3();
+        let axis = Vec3A::from(frame.z.as_vec3());
         let length = axis.length();
         let (t_min, t_max) = if is_unit_length(length) {
             (base.near, base.far)
@@ -127,11 +127,13 @@ impl CameraRayModel for OrthographicCamera {
             (base.near * length, base.far * length)
         };
         OrthographicMap {
-            o_x: (frame.x * scale.x).as_vec3(),
-            o_y: (frame.y * scale.y).as_vec3(),
-            o_1: (frame.eye + frame.x * offset.x + frame.y * offset.y).as_vec3(),
-            lens_x: frame.x.as_vec3(),
-            lens_y: frame.y.as_vec3(),
+            o_x: (frame.x * scale.x).as_vec3().into(),
+            o_y: (frame.y * scale.y).as_vec3().into(),
+            o_1: (frame.eye + frame.x * offset.x + frame.y * offset.y)
+                .as_vec3()
+                .into(),
+            lens_x: frame.x.as_vec3().into(),
+            lens_y: frame.y.as_vec3().into(),
             axis,
             direction: axis / length,
             t_min,
@@ -150,8 +152,8 @@ impl CameraRayModel for OrthographicCamera {
         let p_center = map.o_x * p_film.x + map.o_y * p_film.y + map.o_1;
         if !lens.is_thin_lens() {
             return Ray {
-                origin: Point3::from_glam(p_center),
-                direction: Vector3::from_glam(map.direction),
+                origin: Point3::from_glam(Vec3::from(p_center)),
+                direction: Vector3::from_glam(Vec3::from(map.direction)),
                 time: 0.0,
                 t_min: map.t_min,
                 t_max: map.t_max,
@@ -167,8 +169,8 @@ impl CameraRayModel for OrthographicCamera {
         let length = v.length();
         let per_z = length / lens.focal_distance;
         Ray {
-            origin: Point3::from_glam(p_center + offset),
-            direction: Vector3::from_glam(v / length),
+            origin: Point3::from_glam(Vec3::from(p_center + offset)),
+            direction: Vector3::from_glam(Vec3::from(v / length)),
             time: 0.0,
             t_min: base.near * per_z,
             t_max: base.far * per_z,

@@ -7,7 +7,7 @@ use crate::camera::{
 use crate::error::{CameraError, finite};
 use crate::film::{FilmGeometry, FovAxis, Shutter};
 use crate::projective::{ProjectiveCamera, from_rows};
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec3A};
 use obscura_space::{
     AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, Ray, Vector3, World,
 };
@@ -50,13 +50,13 @@ pub struct PerspectiveCamera {
 /// `near * len` and `far * len` along the unit direction (for any affine pose, scaled or not).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct PerspectiveMap {
-    d_x: Vec3,
-    d_y: Vec3,
-    d_1: Vec3,
-    eye: Vec3,
+    d_x: Vec3A,
+    d_y: Vec3A,
+    d_1: Vec3A,
+    eye: Vec3A,
     /// World images of camera +x and +y: the aperture's axes.
-    lens_x: Vec3,
-    lens_y: Vec3,
+    lens_x: Vec3A,
+    lens_y: Vec3A,
 }
 
 impl PerspectiveCamera {
@@ -159,12 +159,14 @@ impl CameraRayModel for PerspectiveCamera {
             offset * self.plane_from_screen,
         );
         PerspectiveMap {
-            d_x: (frame.x * scale.x).as_vec3(),
-            d_y: (frame.y * scale.y).as_vec3(),
-            d_1: (frame.x * offset.x + frame.y * offset.y + frame.z).as_vec3(),
-            eye: frame.eye.as_vec3(),
-            lens_x: frame.x.as_vec3(),
-            lens_y: frame.y.as_vec3(),
+            d_x: (frame.x * scale.x).as_vec3().into(),
+            d_y: (frame.y * scale.y).as_vec3().into(),
+            d_1: (frame.x * offset.x + frame.y * offset.y + frame.z)
+                .as_vec3()
+                .into(),
+            eye: frame.eye.as_vec3().into(),
+            lens_x: frame.x.as_vec3().into(),
+            lens_y: frame.y.as_vec3().into(),
         }
     }
 
@@ -182,8 +184,8 @@ impl CameraRayModel for PerspectiveCamera {
         if !lens.is_thin_lens() {
             let length = w.length();
             return Ray {
-                origin: Point3::from_glam(map.eye),
-                direction: Vector3::from_glam(w / length),
+                origin: Point3::from_glam(Vec3::from(map.eye)),
+                direction: Vector3::from_glam(Vec3::from(w / length)),
                 time: 0.0,
                 t_min: base.near * length,
                 t_max: base.far * length,
@@ -199,8 +201,8 @@ impl CameraRayModel for PerspectiveCamera {
         let length = v.length();
         let per_z = length / lens.focal_distance;
         Ray {
-            origin: Point3::from_glam(map.eye + offset),
-            direction: Vector3::from_glam(v / length),
+            origin: Point3::from_glam(Vec3::from(map.eye + offset)),
+            direction: Vector3::from_glam(Vec3::from(v / length)),
             time: 0.0,
             t_min: base.near * per_z,
             t_max: base.far * per_z,
