@@ -60,4 +60,4 @@ pub use error::AccelError;
 pub use hit::{Hit, SHADOW_EPSILON};
 pub use mesh::TriangleMesh;
 pub use obj::{load_obj, parse_obj};
-pub use scene::{BuildQuality, Placement, Scene, SceneBuilder, Shape};
+pub use scene::{BuildQuality, MAX_COORDINATE, Placement, Scene, SceneBuilder, Shape};

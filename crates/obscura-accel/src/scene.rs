@@ -86,6 +86,9 @@ pub struct SceneBuilder {
     quality: BuildQuality,
 }
 
+/// How far from the origin (in world units, per axis) any shape may reach, at any time.
+pub const MAX_COORDINATE: f32 = 1e18;
+
 impl SceneBuilder {
     /// An empty builder with [`BuildQuality::Medium`].
     pub fn new() -> Self {
@@ -144,6 +147,44 @@ impl SceneBuilder {
             return Err(AccelError::Placement(
                 "a transform has a NaN or infinite entry".to_string(),
             ));
+        }
+        // Every coordinate the BVH and the intersection tests see must stay far from f32's
+        // overflow: products of two coordinates (cross products, squared distances) must be
+        // finite, or bounds turn infinite and the BVH build and hit tests break down.
+        let object_bounds = match &shape {
+            Shape::Mesh(mesh) => mesh.bounds(),
+            Shape::Sphere { center, radius } => Bounds3::new(
+                Point3::from_glam(*center - Vec3::splat(*radius)),
+                Point3::from_glam(*center + Vec3::splat(*radius)),
+            ),
+            Shape::Quad {
+                origin,
+                edge_u,
+                edge_v,
+            } => Bounds3::from_points(
+                [
+                    *origin,
+                    *origin + *edge_u,
+                    *origin + *edge_v,
+                    *origin + *edge_u + *edge_v,
+                ]
+                .map(Point3::from_glam),
+            ),
+        };
+        let world_bounds = match &placement {
+            Placement::Static(t) => t.bounds(object_bounds),
+            Placement::Moving(a) => a.motion_bounds(object_bounds),
+        };
+        let extent = world_bounds
+            .min
+            .to_glam()
+            .abs()
+            .max(world_bounds.max.to_glam().abs())
+            .max_element();
+        if extent.is_nan() || extent > MAX_COORDINATE {
+            return Err(AccelError::Shape(format!(
+                "the shape reaches {extent:e} units from the origin; shapes must lie within {MAX_COORDINATE:e} (f32 products of coordinates would overflow)"
+            )));
         }
         let index = u32::try_from(self.instances.len())
             .map_err(|_| AccelError::Placement("more than 2^32 instances".to_string()))?;

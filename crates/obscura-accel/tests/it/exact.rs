@@ -277,3 +277,37 @@ fn invalid_input_is_refused_not_panicked_on() {
         assert!(!scene.occluded(&bad));
     }
 }
+
+#[test]
+fn shapes_beyond_the_coordinate_limit_are_refused_not_built() {
+    use obscura_accel::{MAX_COORDINATE, Placement, SceneBuilder, Shape};
+    use obscura_space::{AnimatedTransform, Object, Transform, World};
+    // A radius whose box overflows f32 once doubled (found by the scene-mutation proptest: it
+    // made obvhs's CWBVH conversion assert).
+    let mut b = SceneBuilder::new();
+    let huge = Shape::Sphere {
+        center: glam::Vec3::ZERO,
+        radius: 3.4e38,
+    };
+    assert!(b.add(huge, Placement::Static(Transform::IDENTITY)).is_err());
+    // Just inside the limit is fine; just outside, including by moving there, is not.
+    let inside = Shape::Sphere {
+        center: glam::Vec3::ZERO,
+        radius: MAX_COORDINATE * 0.5,
+    };
+    assert!(
+        b.add(inside, Placement::Static(Transform::IDENTITY))
+            .is_ok()
+    );
+    let small = Shape::Sphere {
+        center: glam::Vec3::ZERO,
+        radius: 1.0,
+    };
+    let far =
+        Transform::<World, Object>::translate(glam::Vec3::new(2.0 * MAX_COORDINATE, 0.0, 0.0))
+            .unwrap();
+    let moving = AnimatedTransform::new(Transform::IDENTITY, 0.0, far, 1.0).unwrap();
+    assert!(b.add(small.clone(), Placement::Moving(moving)).is_err());
+    assert!(b.add(small, Placement::Static(Transform::IDENTITY)).is_ok());
+    assert!(b.build().is_ok());
+}
