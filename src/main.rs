@@ -135,18 +135,27 @@ impl Interrupts {
     fn install() -> Result<Self, RenderError> {
         let cancel = Arc::new(AtomicBool::new(false));
         let signal = Arc::new(AtomicUsize::new(0));
-        for sig in [SIGINT, SIGTERM] {
-            // Order matters: the shutdown action runs first and only fires if an earlier
-            // signal already set the flag; then this signal sets it.
-            signal_hook::flag::register_conditional_shutdown(
-                sig,
-                EXIT_SECOND_SIGNAL,
-                Arc::clone(&cancel),
-            )
-            .and_then(|_| signal_hook::flag::register_usize(sig, Arc::clone(&signal), sig as usize))
-            .and_then(|_| signal_hook::flag::register(sig, Arc::clone(&cancel)))
-            .map_err(|e| setting("render", format!("cannot install the signal handlers: {e}")))?;
-        }
+        let failed = |e: std::io::Error| {
+            setting("render", format!("cannot install the signal handlers: {e}"))
+        };
+        let mut signals = signal_hook::iterator::Signals::new([SIGINT, SIGTERM]).map_err(failed)?;
+        let (first, which) = (Arc::clone(&cancel), Arc::clone(&signal));
+        // One thread takes the signals one at a time, so two that arrive together (say, both
+        // pending while the process was stopped) are still a first and a second. Handlers
+        // running on two threads at once could both see the flag unset.
+        std::thread::Builder::new()
+            .name("signals".into())
+            .spawn(move || {
+                for sig in signals.forever() {
+                    if first.load(Ordering::SeqCst) {
+                        std::process::exit(EXIT_SECOND_SIGNAL);
+                    }
+                    // The signal first, then the flag: whoever sees the flag sees the signal.
+                    which.store(sig as usize, Ordering::SeqCst);
+                    first.store(true, Ordering::SeqCst);
+                }
+            })
+            .map_err(failed)?;
         Ok(Self { cancel, signal })
     }
 
