@@ -450,6 +450,53 @@ pub(crate) fn generate_differential<M: CameraRayModel>(
     })
 }
 
+/// Implements [`Camera`] for a model: rays through [`generate`] and [`generate_differential`],
+/// film, shutter and pose from its [`CameraBase`], and `project` from the model's own
+/// `$project(&self, p_world, time)` method. One definition for the three models' plumbing.
+macro_rules! camera_via_model {
+    ($ty:ty, $project:ident) => {
+        impl $crate::camera::Camera for $ty {
+            #[inline]
+            fn generate_ray(
+                &self,
+                sample: &$crate::camera::CameraSample,
+            ) -> Option<$crate::camera::CameraRay> {
+                $crate::camera::generate(self, sample)
+            }
+            #[inline]
+            fn generate_ray_differential(
+                &self,
+                sample: &$crate::camera::CameraSample,
+            ) -> Option<$crate::camera::CameraRayDifferential> {
+                $crate::camera::generate_differential(self, sample)
+            }
+            fn project(
+                &self,
+                p: obscura_space::Point3<obscura_space::World>,
+                time: f32,
+            ) -> Option<obscura_space::Point2<obscura_space::Raster>> {
+                self.$project(p, time)
+            }
+            #[inline]
+            fn film(&self) -> &$crate::film::FilmGeometry {
+                &$crate::camera::CameraRayModel::base(self).film
+            }
+            #[inline]
+            fn shutter(&self) -> $crate::film::Shutter {
+                $crate::camera::CameraRayModel::base(self).shutter
+            }
+            #[inline]
+            fn world_from_camera(
+                &self,
+            ) -> &obscura_space::AnimatedTransform<obscura_space::World, obscura_space::Camera>
+            {
+                &$crate::camera::CameraRayModel::base(self).world_from_camera
+            }
+        }
+    };
+}
+pub(crate) use camera_via_model;
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,16 +1,10 @@
 //! The environment (equirectangular) camera.
 
-use crate::camera::{
-    Camera, CameraBase, CameraRay, CameraRayDifferential, CameraRayModel, CameraSample, PoseFrame,
-    fixed_map_of, generate, generate_differential, is_unit_length,
-};
+use crate::camera::{CameraBase, CameraRayModel, PoseFrame, fixed_map_of, is_unit_length};
 use crate::error::CameraError;
-use crate::film::{FilmGeometry, Shutter};
 use core::f32::consts::{PI, TAU};
 use glam::{Vec2, Vec3, Vec3A};
-use obscura_space::{
-    AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, Ray, Vector3, World,
-};
+use obscura_space::{Camera as CameraSpace, Point2, Point3, Raster, Ray, Vector3, World};
 
 /// A 360 x 180 degree camera: every ray starts at the eye, and raster `(x, y)` maps to the
 /// direction of SCENE_FORMAT.md, polar angle `theta = pi * y / height` from camera +y and
@@ -133,19 +127,9 @@ impl CameraRayModel for EnvironmentCamera {
     }
 }
 
-impl Camera for EnvironmentCamera {
-    #[inline]
-    fn generate_ray(&self, sample: &CameraSample) -> Option<CameraRay> {
-        generate(self, sample)
-    }
-    #[inline]
-    fn generate_ray_differential(&self, sample: &CameraSample) -> Option<CameraRayDifferential> {
-        generate_differential(self, sample)
-    }
-    /// The inverse mapping: `theta = acos(d.y)`, `phi = atan2(d.x, d.z)` in `(-pi, pi]`, so `x`
-    /// lies in `(0, width]` (the seam `phi = pi` goes to the right edge) and `y` in
-    /// `[0, height]`. None at the eye or outside `[near, far]` in distance.
-    fn project(&self, p: Point3<World>, time: f32) -> Option<Point2<Raster>> {
+impl EnvironmentCamera {
+    /// The raster position of world point `p` at `time` (see [`Camera::project`](crate::Camera::project)).
+    fn project_world(&self, p: Point3<World>, time: f32) -> Option<Point2<Raster>> {
         let camera_from_world = self.base.pose(time).inverse();
         let v_camera = camera_from_world.point(p).to_vector();
         let distance = v_camera.length();
@@ -158,16 +142,6 @@ impl Camera for EnvironmentCamera {
         let [width, height] = self.base.film.resolution().map(|r| r as f32);
         Some(Point2::new(width * (phi / TAU + 0.5), height * theta / PI))
     }
-    #[inline]
-    fn film(&self) -> &FilmGeometry {
-        &self.base.film
-    }
-    #[inline]
-    fn shutter(&self) -> Shutter {
-        self.base.shutter
-    }
-    #[inline]
-    fn world_from_camera(&self) -> &AnimatedTransform<World, CameraSpace> {
-        &self.base.world_from_camera
-    }
 }
+
+crate::camera::camera_via_model!(EnvironmentCamera, project_world);

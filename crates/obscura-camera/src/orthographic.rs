@@ -1,16 +1,12 @@
 //! The orthographic camera, pinhole or thin lens.
 
 use crate::camera::{
-    Camera, CameraBase, CameraRay, CameraRayDifferential, CameraRayModel, CameraSample, PoseFrame,
-    ThinLens, fixed_map_of, generate, generate_differential, is_unit_length,
+    CameraBase, CameraRayModel, PoseFrame, ThinLens, fixed_map_of, is_unit_length,
 };
 use crate::error::CameraError;
-use crate::film::{FilmGeometry, Shutter};
 use crate::projective::{ProjectiveCamera, from_rows};
 use glam::{Vec2, Vec3, Vec3A};
-use obscura_space::{
-    AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, Ray, Vector3, World,
-};
+use obscura_space::{Camera as CameraSpace, Point2, Point3, Raster, Ray, Vector3, World};
 
 /// An orthographic camera: a parallel projection of the box between `near` and `far` whose
 /// cross-section is the screen window, in camera-space world units. Rays start on the plane
@@ -178,29 +174,12 @@ impl CameraRayModel for OrthographicCamera {
     }
 }
 
-impl Camera for OrthographicCamera {
-    #[inline]
-    fn generate_ray(&self, sample: &CameraSample) -> Option<CameraRay> {
-        generate(self, sample)
-    }
-    #[inline]
-    fn generate_ray_differential(&self, sample: &CameraSample) -> Option<CameraRayDifferential> {
-        generate_differential(self, sample)
-    }
-    fn project(&self, p: Point3<World>, time: f32) -> Option<Point2<Raster>> {
+impl OrthographicCamera {
+    /// The raster position of world point `p` at `time` (see [`Camera::project`](crate::Camera::project)).
+    fn project_world(&self, p: Point3<World>, time: f32) -> Option<Point2<Raster>> {
         let camera_from_world = self.base().pose(time).inverse();
         self.projective.project_camera(camera_from_world.point(p))
     }
-    #[inline]
-    fn film(&self) -> &FilmGeometry {
-        &self.base().film
-    }
-    #[inline]
-    fn shutter(&self) -> Shutter {
-        self.base().shutter
-    }
-    #[inline]
-    fn world_from_camera(&self) -> &AnimatedTransform<World, CameraSpace> {
-        &self.base().world_from_camera
-    }
 }
+
+crate::camera::camera_via_model!(OrthographicCamera, project_world);
