@@ -18,51 +18,9 @@
 //! [`BuildQuality`].
 
 use obscura_accel::{BuildQuality, Placement, Scene, SceneBuilder, Shape, testmesh};
-use obscura_space::{Point3, Ray, Transform, Vector3, World};
+use obscura_space::{Ray, Transform, World};
 use std::hint::black_box;
 use std::sync::Arc;
-
-/// A 256 x 256 pinhole grid from (0, 0, 3) looking down -z over a 60-degree field.
-fn primary_rays() -> Vec<Ray<World>> {
-    let n = 256;
-    let half = (30.0f32).to_radians().tan();
-    let mut rays = Vec::with_capacity(n * n);
-    for j in 0..n {
-        for i in 0..n {
-            let x = ((i as f32 + 0.5) / n as f32 * 2.0 - 1.0) * half;
-            let y = (1.0 - (j as f32 + 0.5) / n as f32 * 2.0) * half;
-            let d = Vector3::new(x, y, -1.0).normalize();
-            rays.push(Ray::new(Point3::new(0.0, 0.0, 3.0), d, 0.0));
-        }
-    }
-    rays
-}
-
-/// 65,536 rays from random points on a sphere of radius 3 towards random points in the unit
-/// cube (a fixed xorshift sequence).
-fn random_rays() -> Vec<Ray<World>> {
-    let mut state = 0x2545_F491_4F6C_DD1Du64;
-    let mut u = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 40) as f32 / (1u64 << 24) as f32
-    };
-    (0..65_536)
-        .map(|_| {
-            let on_sphere = loop {
-                let v = Vector3::<World>::new(2.0 * u() - 1.0, 2.0 * u() - 1.0, 2.0 * u() - 1.0);
-                let l = v.length();
-                if l > 0.1 && l <= 1.0 {
-                    break v * (3.0 / l);
-                }
-            };
-            let origin = Point3::ORIGIN + on_sphere;
-            let target = Point3::new(2.0 * u() - 1.0, 2.0 * u() - 1.0, 2.0 * u() - 1.0);
-            Ray::new(origin, (target - origin).normalize(), 0.0)
-        })
-        .collect()
-}
 
 #[inline(never)]
 fn closest_primary(scene: &Scene, rays: &[Ray<World>]) -> f64 {
@@ -118,7 +76,7 @@ fn main() {
         )
         .expect("a static identity placement is valid");
     let scene = builder.build().expect("one mesh builds");
-    let (primary, random) = (primary_rays(), random_rays());
+    let (primary, random) = (testmesh::primary_rays(), testmesh::random_rays());
     setup_done(&scene);
     println!(
         "closest primary {:.3}",

@@ -5,10 +5,13 @@
 //! - [`displaced_grid`]: an `n x n` grid of quads (`2 n^2` triangles) over `[-1, 1]^2` in the
 //!   xy plane, z displaced by a sum of sines, with per-vertex uvs; n = 708 gives about a
 //!   million triangles.
+//! - [`primary_rays`] and [`random_rays`]: the coherent and incoherent ray sets the benchmarks
+//!   and profiling examples trace at these meshes.
 
 use crate::error::AccelError;
 use crate::mesh::TriangleMesh;
 use glam::{Vec2, Vec3};
+use obscura_space::{Point3, Ray, Vector3, World};
 use std::collections::HashMap;
 
 /// The largest subdivision level [`icosphere`] accepts (20 * 4^10, about 21 million triangles).
@@ -121,6 +124,49 @@ pub fn displaced_grid(n: u32) -> Result<TriangleMesh, AccelError> {
         }
     }
     TriangleMesh::new(positions, triangles, None, Some(uvs))
+}
+
+/// A 256 x 256 pinhole grid of rays from (0, 0, 3) looking down -z over a 60-degree square
+/// field: coherent primary rays at meshes within the unit cube around the origin.
+pub fn primary_rays() -> Vec<Ray<World>> {
+    let n = 256;
+    let half = (30.0f32).to_radians().tan();
+    let mut rays = Vec::with_capacity(n * n);
+    for j in 0..n {
+        for i in 0..n {
+            let x = ((i as f32 + 0.5) / n as f32 * 2.0 - 1.0) * half;
+            let y = (1.0 - (j as f32 + 0.5) / n as f32 * 2.0) * half;
+            let d = Vector3::new(x, y, -1.0).normalize();
+            rays.push(Ray::new(Point3::new(0.0, 0.0, 3.0), d, 0.0));
+        }
+    }
+    rays
+}
+
+/// 65,536 incoherent rays from random points on a sphere of radius 3 towards random points in
+/// the unit cube (a fixed xorshift sequence, so every run traces the same rays).
+pub fn random_rays() -> Vec<Ray<World>> {
+    let mut state = 0x2545_F491_4F6C_DD1Du64;
+    let mut u = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 40) as f32 / (1u64 << 24) as f32
+    };
+    (0..65_536)
+        .map(|_| {
+            let on_sphere = loop {
+                let v = Vector3::<World>::new(2.0 * u() - 1.0, 2.0 * u() - 1.0, 2.0 * u() - 1.0);
+                let l = v.length();
+                if l > 0.1 && l <= 1.0 {
+                    break v * (3.0 / l);
+                }
+            };
+            let origin = Point3::ORIGIN + on_sphere;
+            let target = Point3::new(2.0 * u() - 1.0, 2.0 * u() - 1.0, 2.0 * u() - 1.0);
+            Ray::new(origin, (target - origin).normalize(), 0.0)
+        })
+        .collect()
 }
 
 #[cfg(test)]
