@@ -27,37 +27,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Render a scene file to an EXR or PNG image.
-    Render {
-        /// The scene file (TOML).
-        scene: PathBuf,
-        /// Output image, .exr or .png [default: the scene's name with .exr]
-        #[arg(short = 'o', long = "output")]
-        output: Option<PathBuf>,
-        /// Samples per pixel (overrides the scene's)
-        #[arg(long)]
-        spp: Option<u32>,
-        /// Sampler seed (overrides the scene's)
-        #[arg(long)]
-        seed: Option<u64>,
-        /// Worker threads [default: one per core]
-        #[arg(long)]
-        threads: Option<usize>,
-        /// Integrator: path, depth, distance, position, normal or albedo
-        #[arg(long)]
-        integrator: Option<String>,
-        /// Image size as WIDTHxHEIGHT (overrides the scene's)
-        #[arg(long)]
-        resolution: Option<String>,
-        /// Save the film's sums to this file now and then, on interrupt and at the end
-        #[arg(long, value_name = "FILE")]
-        checkpoint: Option<PathBuf>,
-        /// Seconds between checkpoints (0: after every pass)
-        #[arg(long, value_name = "SECONDS", default_value_t = 60.0)]
-        checkpoint_every: f64,
-        /// Continue a render from a checkpoint made with the same scene and flags
-        #[arg(long, value_name = "FILE")]
-        resume: Option<PathBuf>,
-    },
+    Render(RenderArgs),
     /// Parse and validate a scene, print a summary, render nothing.
     Check {
         /// The scene file (TOML).
@@ -68,29 +38,7 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Render {
-            scene,
-            output,
-            spp,
-            seed,
-            threads,
-            integrator,
-            resolution,
-            checkpoint,
-            checkpoint_every,
-            resume,
-        } => run_render(RenderArgs {
-            scene_path: scene,
-            output,
-            spp,
-            seed,
-            threads,
-            integrator,
-            resolution,
-            checkpoint,
-            checkpoint_every,
-            resume,
-        }),
+        Command::Render(args) => run_render(args),
         Command::Check { scene } => run_check(&scene).map(|()| ExitCode::SUCCESS),
     };
     match result {
@@ -110,16 +58,37 @@ fn setting(name: &'static str, message: impl Into<String>) -> RenderError {
 }
 
 /// The `render` subcommand's arguments.
+#[derive(clap::Args)]
 struct RenderArgs {
+    /// The scene file (TOML).
+    #[arg(value_name = "SCENE")]
     scene_path: PathBuf,
+    /// Output image, .exr or .png [default: the scene's name with .exr]
+    #[arg(short = 'o', long = "output")]
     output: Option<PathBuf>,
+    /// Samples per pixel (overrides the scene's)
+    #[arg(long)]
     spp: Option<u32>,
+    /// Sampler seed (overrides the scene's)
+    #[arg(long)]
     seed: Option<u64>,
+    /// Worker threads [default: one per core]
+    #[arg(long)]
     threads: Option<usize>,
+    /// Integrator: path, depth, distance, position, normal or albedo
+    #[arg(long)]
     integrator: Option<String>,
+    /// Image size as WIDTHxHEIGHT (overrides the scene's)
+    #[arg(long)]
     resolution: Option<String>,
+    /// Save the film's sums to this file now and then, on interrupt and at the end
+    #[arg(long, value_name = "FILE")]
     checkpoint: Option<PathBuf>,
+    /// Seconds between checkpoints (0: after every pass)
+    #[arg(long, value_name = "SECONDS", default_value_t = 60.0)]
     checkpoint_every: f64,
+    /// Continue a render from a checkpoint made with the same scene and flags
+    #[arg(long, value_name = "FILE")]
     resume: Option<PathBuf>,
 }
 
