@@ -6,6 +6,7 @@ use std::f32::consts::{FRAC_1_PI, FRAC_PI_2, FRAC_PI_4, PI, TAU};
 use glam::{Vec2, Vec3};
 
 use crate::hash::ONE_MINUS_EPSILON;
+use crate::trig::sin_cos_pi_kernel;
 
 /// Clamps a canonical coordinate to `[0, 1)`.
 #[inline]
@@ -25,13 +26,23 @@ pub fn square_to_concentric_disk(u: Vec2) -> Vec2 {
     if offset.x == 0.0 && offset.y == 0.0 {
         return Vec2::ZERO;
     }
-    // Pick the triangle (the larger coordinate is the radius) and the angle along it.
-    let (r, theta) = if offset.x.abs() > offset.y.abs() {
-        (offset.x, FRAC_PI_4 * (offset.y / offset.x))
+    // Pick the triangle: the larger coordinate is the radius r, the other over it, t in
+    // [-1, 1], the position along the triangle's edge.
+    let swap = offset.x.abs() <= offset.y.abs();
+    let (r, other) = if swap {
+        (offset.y, offset.x)
     } else {
-        (offset.y, FRAC_PI_2 - FRAC_PI_4 * (offset.x / offset.y))
+        (offset.x, offset.y)
     };
-    r * Vec2::new(theta.cos(), theta.sin())
+    // The angle pi/4 t from the radius axis, in half-turns t/4 (exact), within [-1/4, 1/4].
+    let (sin, cos) = sin_cos_pi_kernel(0.25 * (other / r));
+    // Left and right triangles: r (cos, sin). Top and bottom: the angle is measured from +y
+    // the other way round, pi/2 - pi/4 t, and (cos, sin)(pi/2 - a) = (sin, cos)(a).
+    if swap {
+        r * Vec2::new(sin, cos)
+    } else {
+        r * Vec2::new(cos, sin)
+    }
 }
 
 /// The inverse of [`square_to_concentric_disk`]: a point of the unit disk back to `[0, 1)^2`.

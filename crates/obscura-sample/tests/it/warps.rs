@@ -102,6 +102,17 @@ proptest! {
     }
 
     #[test]
+    fn sin_cos_pi_matches_f64(x in -1.0e6f32..1.0e6) {
+        // x is exact in f64 and pi x there is within 1e6 * 2^-52 ~ 2e-10 of the true angle,
+        // so f64's sine and cosine are references to far better than f32 precision.
+        let (sin, cos) = sin_cos_pi(x);
+        let (sin_64, cos_64) = (std::f64::consts::PI * f64::from(x)).sin_cos();
+        prop_assert!((f64::from(sin) - sin_64).abs() <= 7.5e-8 + 2e-10, "sin(pi {x}) = {sin}");
+        prop_assert!((f64::from(cos) - cos_64).abs() <= 7.5e-8 + 2e-10, "cos(pi {x}) = {cos}");
+        prop_assert!((sin * sin + cos * cos - 1.0).abs() <= 2e-7, "{sin}^2 + {cos}^2");
+    }
+
+    #[test]
     fn shutter_sample_lands_in_the_interval_and_inverts(u in 0.0f32..1.0, ramp in 0.0f32..=0.5) {
         let curve = ShutterCurve::trapezoid(ramp).unwrap();
         let t = curve.sample(u);
