@@ -107,7 +107,9 @@ impl CameraRayModel for EnvironmentCamera {
         self.fixed.as_ref()
     }
 
-    #[inline]
+    // Always: the per-ray body; left to LLVM it fell out of line once the aperture warp
+    // was inlined, costing a call and spills (perspective pinhole 84 -> 104 instructions).
+    #[inline(always)]
     fn ray_world(&self, map: &EnvironmentMap, p_film: Point2<Raster>, _u_lens: Vec2) -> Ray<World> {
         let d_camera = self.direction(p_film);
         let w = map.x * d_camera.x + map.y * d_camera.y + map.z * d_camera.z;

@@ -142,7 +142,9 @@ impl CameraRayModel for OrthographicCamera {
         self.fixed.as_ref()
     }
 
-    #[inline]
+    // Always: the per-ray body; left to LLVM it fell out of line once the aperture warp
+    // was inlined, costing a call and spills (perspective pinhole 84 -> 104 instructions).
+    #[inline(always)]
     fn ray_world(&self, map: &OrthographicMap, p_film: Point2<Raster>, u_lens: Vec2) -> Ray<World> {
         let lens = self.projective.lens();
         let p_center = map.o_x * p_film.x + map.o_y * p_film.y + map.o_1;

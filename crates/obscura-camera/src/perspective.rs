@@ -170,7 +170,9 @@ impl CameraRayModel for PerspectiveCamera {
         self.fixed.as_ref()
     }
 
-    #[inline]
+    // Always: the per-ray body; left to LLVM it fell out of line once the aperture warp
+    // was inlined, costing a call and spills (perspective pinhole 84 -> 104 instructions).
+    #[inline(always)]
     fn ray_world(&self, map: &PerspectiveMap, p_film: Point2<Raster>, u_lens: Vec2) -> Ray<World> {
         let base = self.projective.base();
         let lens = self.projective.lens();
