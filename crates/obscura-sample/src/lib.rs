@@ -8,7 +8,7 @@
 //! the camera's [`CameraDims`]. Warps turn canonical numbers into shapes:
 //! [`square_to_concentric_disk`] and [`square_to_polygon`] for the aperture,
 //! [`ShutterCurve`] and [`shutter_time`] for the shutter, [`square_to_cosine_hemisphere`] and
-//! [`square_to_uniform_sphere`] for shading, each with its pdf. [`sin_cos_pi`] is the short
+//! [`square_to_uniform_sphere`] for shading, each with its pdf. [`sin_cos_pi`] (and [`sin_cos_pi_vec4`]) is the short
 //! sine and cosine the per-sample warps and cameras use instead of libm's. Errors are
 //! [`SampleError`].
 //!
@@ -58,7 +58,7 @@ pub use error::SampleError;
 pub use hash::ONE_MINUS_EPSILON;
 pub use sampler::{CameraDims, MAX_SAMPLES_PER_PIXEL, SampleStream, Sampler, SamplerKind};
 pub use shutter::{ShutterCurve, shutter_time};
-pub use trig::sin_cos_pi;
+pub use trig::{sin_cos_pi, sin_cos_pi_vec4};
 pub use warp::{
     concentric_disk_pdf, concentric_disk_to_square, cosine_hemisphere_pdf,
     cosine_hemisphere_to_square, polygon_pdf, polygon_to_square, square_to_concentric_disk,

@@ -7,6 +7,10 @@
 //! the image), so they are formed without multiplying by a rounded `pi`, and the reduction to
 //! `[-1/4, 1/4]` is exact.
 
+use core::ops::{Add, Mul, Sub};
+
+use glam::{BVec4A, Vec4};
+
 /// `sin(pi r) = 4 r - r (D0 - r^2 P(r^2))` on `|r| <= 1/4`, `D0 = 4 - pi` and `P` below: a
 /// near-minimax fit of `sin(pi r) / r` by a cubic in `r^2` (Lawson's iteratively reweighted
 /// least squares on 4000 Chebyshev-spaced points in f64), maximum error 9.7e-9 before rounding
@@ -26,16 +30,94 @@ const SIN_P: [f32; 3] = [-5.167_708, 2.549_767_3, -0.589_078_6];
 const COS_Q: [f32; 4] = [-4.934_802, 4.058_708, -1.335_058_5, 0.231_429_55];
 
 /// `1.5 * 2^23`: adding and subtracting it rounds an f32 of magnitude at most `2^22` to the
-/// nearest integer (the sum lies in `[2^23, 2^24)`, where the spacing of f32 is 1), without
-/// the libm call `f32::round` is on targets without SSE4.1.
+/// nearest integer, ties to even (the sum lies in `[2^23, 2^24)`, where the spacing of f32 is
+/// 1), without the libm call `f32::round` is on targets without SSE4.1, and lane-wise.
 const ROUNDING_MAGIC: f32 = 12_582_912.0;
+
+/// Numbers the kernel and the reduction run on: `f32`, and glam's [`Vec4`] (four lanes at once,
+/// SSE2 on x86-64) for callers with several angles per sample. The same sequence of IEEE
+/// operations runs on each lane, so a lane of the `Vec4` version equals the `f32` version bit
+/// for bit.
+pub(crate) trait Lanes:
+    Copy
+    + Add<Self, Output = Self>
+    + Sub<Self, Output = Self>
+    + Mul<Self, Output = Self>
+    + Add<f32, Output = Self>
+    + Sub<f32, Output = Self>
+    + Mul<f32, Output = Self>
+{
+    /// A per-lane truth value.
+    type Mask: Copy;
+    /// `x` in every lane.
+    fn splat(x: f32) -> Self;
+    /// Per-lane `|self|`.
+    fn abs(self) -> Self;
+    /// Per-lane `self > bound`.
+    fn greater_than(self, bound: f32) -> Self::Mask;
+    /// Per lane, `if_true` where the mask holds, else `if_false`.
+    fn select(mask: Self::Mask, if_true: Self, if_false: Self) -> Self;
+    /// Per lane, the magnitude of `self` with the sign of `sign`.
+    fn copysign(self, sign: Self) -> Self;
+}
+
+impl Lanes for f32 {
+    type Mask = bool;
+    #[inline(always)]
+    fn splat(x: f32) -> f32 {
+        x
+    }
+    #[inline(always)]
+    fn abs(self) -> f32 {
+        f32::abs(self)
+    }
+    #[inline(always)]
+    fn greater_than(self, bound: f32) -> bool {
+        self > bound
+    }
+    #[inline(always)]
+    fn select(mask: bool, if_true: f32, if_false: f32) -> f32 {
+        if mask { if_true } else { if_false }
+    }
+    #[inline(always)]
+    fn copysign(self, sign: f32) -> f32 {
+        f32::copysign(self, sign)
+    }
+}
+
+impl Lanes for Vec4 {
+    type Mask = BVec4A;
+    #[inline(always)]
+    fn splat(x: f32) -> Vec4 {
+        Vec4::splat(x)
+    }
+    #[inline(always)]
+    fn abs(self) -> Vec4 {
+        Vec4::abs(self)
+    }
+    #[inline(always)]
+    fn greater_than(self, bound: f32) -> BVec4A {
+        self.cmpgt(Vec4::splat(bound))
+    }
+    #[inline(always)]
+    fn select(mask: BVec4A, if_true: Vec4, if_false: Vec4) -> Vec4 {
+        Vec4::select(mask, if_true, if_false)
+    }
+    #[inline(always)]
+    fn copysign(self, sign: Vec4) -> Vec4 {
+        Vec4::copysign(self, sign)
+    }
+}
 
 /// `(sin(pi r), cos(pi r))` for `|r| <= 1/4` (the kernel; no reduction).
 #[inline(always)]
-pub(crate) fn sin_cos_pi_kernel(r: f32) -> (f32, f32) {
+pub(crate) fn sin_cos_pi_kernel<T: Lanes>(r: T) -> (T, T) {
     let z = r * r;
-    let sin = 4.0 * r - r * (SIN_D0 - z * (SIN_P[0] + z * (SIN_P[1] + z * SIN_P[2])));
-    let cos = 1.0 + z * (COS_Q[0] + z * (COS_Q[1] + z * (COS_Q[2] + z * COS_Q[3])));
+    // sin = 4 r - r (D0 - p) = 4 r + r (p - D0); the negation is exact, so either form
+    // rounds the same.
+    let p = ((z * SIN_P[2] + SIN_P[1]) * z + SIN_P[0]) * z;
+    let sin = r * 4.0 + r * (p - SIN_D0);
+    let cos = ((((z * COS_Q[3] + COS_Q[2]) * z + COS_Q[1]) * z + COS_Q[0]) * z) + 1.0;
     (sin, cos)
 }
 
@@ -47,13 +129,15 @@ pub(crate) fn sin_cos_pi_kernel(r: f32) -> (f32, f32) {
 /// 1.2 ulp of values in `[1/2, 1)`; libm's `sinf` is within 0.5 ulp), a relative error below
 /// `2^-22` (2 ulp) for small sines, and `sin^2 + cos^2` within `2e-7` of 1 (measured 1.6e-7).
 /// The multiples of one half are exact: `sin_cos_pi(1.0) == (0.0, -1.0)`,
-/// `sin_cos_pi(0.5) == (1.0, 0.0)` (up to the sign of zero).
+/// `sin_cos_pi(0.5) == (1.0, 0.0)` (up to the sign of zero). Odd and even: `sin_cos_pi(-x)`
+/// is `(-sin, cos)` of `sin_cos_pi(x)`, exactly.
 ///
-/// How: `k`, the multiple of one half nearest `x`, is found by the add-and-subtract rounding
-/// trick, `r = x - k / 2` is then exact (Sterbenz) and in `[-1/4, 1/4]`, short polynomials
-/// give the sine and cosine of `pi r`, and the quadrant `k mod 4` swaps and negates them.
-/// Arguments beyond `2^21` (where f32 spacing is already 1/4) are first reduced exactly modulo
-/// 2 (the slow path).
+/// How, without branches or libm: `n`, the integer nearest `x`, is found by the
+/// add-and-subtract rounding trick; `y = x - n` is then exact (Sterbenz) and in `[-1/2, 1/2]`;
+/// where `|y| > 1/4` the complement `1/2 - |y|` (exact too) goes to the polynomials instead and
+/// the sine and cosine swap; the sign of `y` gives the sine's sign and the parity of `n` flips
+/// both. Arguments beyond `2^21` (where f32 spacing is already 1/4) are first reduced exactly
+/// modulo 2 on a slow path. [`sin_cos_pi_vec4`] does four angles at once.
 ///
 /// ```
 /// use obscura_sample::sin_cos_pi;
@@ -65,31 +149,80 @@ pub(crate) fn sin_cos_pi_kernel(r: f32) -> (f32, f32) {
 #[inline]
 pub fn sin_cos_pi(x: f32) -> (f32, f32) {
     // False for NaN too, which then takes the slow path.
-    let in_fast_range = x.abs() <= 2_097_152.0;
-    if !in_fast_range {
-        return if x.is_finite() {
-            // Exact: the remainder of f32 division is representable.
-            sin_cos_pi(x % 2.0)
-        } else {
-            (f32::NAN, f32::NAN)
-        };
-    }
-    // The nearest multiple of one half, k / 2, and the exact remainder r in [-1/4, 1/4].
-    let k = (2.0 * x + ROUNDING_MAGIC) - ROUNDING_MAGIC;
-    let r = x - 0.5 * k;
-    let (sin, cos) = sin_cos_pi_kernel(r);
-    // Rotate by the quadrant k mod 4 (two's complement keeps k & 3 right for negative k):
-    // by a quarter turn, (sin, cos) -> (cos, -sin); by a half turn, both negate.
-    let quadrant = k as i32;
-    let (sin, cos) = if quadrant & 1 == 0 {
-        (sin, cos)
+    let in_fast_range = x.abs() <= FAST_RANGE;
+    if in_fast_range {
+        sin_cos_pi_reduced(x)
     } else {
-        (cos, -sin)
-    };
-    let half_turn_sign = (quadrant as u32 & 2) << 30;
+        sin_cos_pi_slow(x)
+    }
+}
+
+/// [`sin_cos_pi`] of each lane: `(sin(pi x), cos(pi x))` lane by lane, each lane bit for bit
+/// what [`sin_cos_pi`] gives, at about the cost of one scalar call for all four on x86-64.
+///
+/// ```
+/// use glam::Vec4;
+/// use obscura_sample::{sin_cos_pi, sin_cos_pi_vec4};
+///
+/// let x = Vec4::new(0.1, -0.7, 1.25, 3.0);
+/// let (sin, cos) = sin_cos_pi_vec4(x);
+/// assert_eq!((sin.z, cos.z), sin_cos_pi(1.25));
+/// ```
+#[inline]
+pub fn sin_cos_pi_vec4(x: Vec4) -> (Vec4, Vec4) {
+    // All lanes in range (false for NaN too).
+    if x.abs().cmple(Vec4::splat(FAST_RANGE)).all() {
+        sin_cos_pi_reduced(x)
+    } else {
+        sin_cos_pi_vec4_slow(x)
+    }
+}
+
+/// The largest argument of the fast path, `2^21`: `x + MAGIC` must round to an integer.
+const FAST_RANGE: f32 = 2_097_152.0;
+
+/// [`sin_cos_pi`] for `|x| <= 2^21`, on any [`Lanes`].
+#[inline(always)]
+fn sin_cos_pi_reduced<T: Lanes>(x: T) -> (T, T) {
+    // The nearest integer n and the exact remainder y in [-1/2, 1/2].
+    let n = (x + ROUNDING_MAGIC) - ROUNDING_MAGIC;
+    let y = x - n;
+    // Fold |y| into [0, 1/4]: past a quarter turn, sin(pi a) = cos(pi (1/2 - a)) and back.
+    let a = y.abs();
+    let swap = a.greater_than(0.25);
+    let r = T::select(swap, T::splat(0.5) - a, a);
+    let (sin_r, cos_r) = sin_cos_pi_kernel(r);
+    let sin_abs = T::select(swap, cos_r, sin_r);
+    let cos = T::select(swap, sin_r, cos_r);
+    // The sine is odd in y; an odd n adds a half turn, which negates both. The parity: half of
+    // n (exact) minus its rounding is 0 for even n and +-1/2 for odd n, so `parity_sign` is
+    // exactly 1 or -1.
+    let half_n = n * 0.5;
+    let half_n_rounded = (half_n + ROUNDING_MAGIC) - ROUNDING_MAGIC;
+    let parity_sign = T::splat(1.0) - (half_n - half_n_rounded).abs() * 4.0;
+    (sin_abs.copysign(y) * parity_sign, cos * parity_sign)
+}
+
+/// [`sin_cos_pi`] beyond `2^21` and for non-finite arguments: out of line, off the hot path.
+#[cold]
+#[inline(never)]
+fn sin_cos_pi_slow(x: f32) -> (f32, f32) {
+    if x.is_finite() {
+        // Exact: the remainder of f32 division is representable, and below 2 in magnitude.
+        sin_cos_pi_reduced(x % 2.0)
+    } else {
+        (f32::NAN, f32::NAN)
+    }
+}
+
+/// [`sin_cos_pi_vec4`] when a lane is beyond `2^21` or not finite: lane by lane.
+#[cold]
+#[inline(never)]
+fn sin_cos_pi_vec4_slow(x: Vec4) -> (Vec4, Vec4) {
+    let lanes = x.to_array().map(sin_cos_pi);
     (
-        f32::from_bits(sin.to_bits() ^ half_turn_sign),
-        f32::from_bits(cos.to_bits() ^ half_turn_sign),
+        Vec4::from_array(lanes.map(|(sin, _)| sin)),
+        Vec4::from_array(lanes.map(|(_, cos)| cos)),
     )
 }
 
@@ -172,6 +305,26 @@ mod tests {
     }
 
     #[test]
+    fn vec4_lanes_equal_the_scalar_bit_for_bit_and_the_sine_is_odd() {
+        // A grid over [-3, 3] that is not aligned with the quarters, four lanes at a time,
+        // one lane out of the fast range half of the time (then the whole vector takes the
+        // slow path, which must agree too).
+        for i in 0..100_000 {
+            let x0 = -3.0 + 6.0 * (i as f32 / 100_000.0) + 1e-5;
+            let far = if i % 2 == 0 { 1.0e7 + x0 } else { x0 * 0.5 };
+            let x = Vec4::new(x0, -x0, 0.25 * x0, far);
+            let (sin, cos) = sin_cos_pi_vec4(x);
+            for lane in 0..4 {
+                let (s, c) = sin_cos_pi(x[lane]);
+                assert_eq!(sin[lane].to_bits(), s.to_bits(), "sin, lane {lane} of {x}");
+                assert_eq!(cos[lane].to_bits(), c.to_bits(), "cos, lane {lane} of {x}");
+            }
+            // Odd and even, exactly: the reduction works on |y| and copies the sign back.
+            assert_eq!((sin.y, cos.y), (-sin.x, cos.x), "{x0}");
+        }
+    }
+
+    #[test]
     fn multiples_of_a_half_are_exact() {
         // sin(pi k/2), cos(pi k/2) for k = -4..4: the kernel at r = 0 gives (0, 1) exactly,
         // and the quadrant rotation only swaps and negates.
@@ -216,6 +369,13 @@ mod tests {
         for x in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
             let (sin, cos) = sin_cos_pi(x);
             assert!(sin.is_nan() && cos.is_nan(), "{x}");
+            // One bad lane does not spoil the others.
+            let (sin, cos) = sin_cos_pi_vec4(Vec4::new(0.5, x, 0.0, 1.0));
+            assert!(sin.y.is_nan() && cos.y.is_nan(), "{x}");
+            assert_eq!(
+                (sin.x, cos.x, sin.z, cos.z, cos.w),
+                (1.0, 0.0, 0.0, 1.0, -1.0)
+            );
         }
     }
 }
