@@ -3,7 +3,8 @@
 use crate::camera::{CameraBase, CameraRayModel, PoseFrame, fixed_map_of, is_unit_length};
 use crate::error::CameraError;
 use core::f32::consts::{PI, TAU};
-use glam::{Vec2, Vec3, Vec3A};
+use glam::{Vec2, Vec3, Vec3A, Vec4};
+use obscura_sample::sin_cos_pi_vec4;
 use obscura_space::{Camera as CameraSpace, Point2, Point3, Raster, Ray, Vector3, World};
 
 /// A 360 x 180 degree camera: every ray starts at the eye, and raster `(x, y)` maps to the
@@ -19,8 +20,10 @@ use obscura_space::{Camera as CameraSpace, Point2, Point3, Raster, Ray, Vector3,
 #[derive(Debug, Clone)]
 pub struct EnvironmentCamera {
     base: CameraBase,
-    /// Radians per raster unit: `pi / height` for theta, `2 pi / width` for phi.
-    angle_scale: Vec2,
+    /// Half-turns per raster unit: `2 / width` for phi, `1 / height` for theta (angles are
+    /// kept in units of pi, so that [`sin_cos_pi_vec4`] reduces them exactly and the poles and the
+    /// image centre get exact sines and cosines).
+    half_turns_per_raster: Vec2,
     /// The fast path's constants of a fixed pose.
     fixed: Option<EnvironmentMap>,
 }
@@ -44,7 +47,7 @@ impl EnvironmentCamera {
         let [width, height] = base.film.resolution().map(|r| r as f32);
         let mut camera = EnvironmentCamera {
             base,
-            angle_scale: Vec2::new(TAU / width, PI / height),
+            half_turns_per_raster: Vec2::new(2.0 / width, 1.0 / height),
             fixed: None,
         };
         camera.fixed = fixed_map_of(&camera);
@@ -60,11 +63,13 @@ impl EnvironmentCamera {
     /// The camera-space unit direction of a raster position.
     #[inline]
     pub fn direction(&self, p_film: Point2<Raster>) -> Vector3<CameraSpace> {
-        // Spherical angles of the raster position.
-        let theta = self.angle_scale.y * p_film.y;
-        let phi = self.angle_scale.x * p_film.x - PI;
-        let (sin_theta, cos_theta) = theta.sin_cos();
-        let (sin_phi, cos_phi) = phi.sin_cos();
+        // Spherical angles of the raster position, in half-turns: theta / pi = y / height,
+        // phi / pi = 2 x / width - 1.
+        let theta = self.half_turns_per_raster.y * p_film.y;
+        let phi = self.half_turns_per_raster.x * p_film.x - 1.0;
+        // Both at once, in two lanes.
+        let (sin, cos) = sin_cos_pi_vec4(Vec4::new(theta, phi, 0.0, 0.0));
+        let (sin_theta, cos_theta, sin_phi, cos_phi) = (sin.x, cos.x, sin.y, cos.y);
         Vector3::new(sin_theta * sin_phi, cos_theta, sin_theta * cos_phi)
     }
 }
