@@ -279,3 +279,42 @@ fn non_finite_samples_give_no_ray() {
     sample.time = f32::INFINITY;
     assert!(camera.generate_ray_differential(&sample).is_none());
 }
+
+/// Every field of the sample is checked, against every kind of non-finite number: the check
+/// is one sum of `0 * v` terms, so each term must be able to spoil it on its own.
+#[test]
+fn each_non_finite_field_alone_gives_no_ray() {
+    let camera = PerspectiveCamera::new(
+        base_at(identity_look(), [4, 4], None, 0.01, 100.0),
+        50.0,
+        FovAxis::Smaller,
+        ThinLens::new(0.1, 2.0).unwrap(),
+    )
+    .unwrap();
+    let good = CameraSample {
+        p_film: Point2::new(1.5, 2.5),
+        p_lens: glam::Vec2::new(0.25, 0.75),
+        time: 0.5,
+    };
+    assert!(camera.generate_ray(&good).is_some());
+    for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+        for field in 0..5 {
+            let mut sample = good;
+            match field {
+                0 => sample.p_film.x = bad,
+                1 => sample.p_film.y = bad,
+                2 => sample.p_lens.x = bad,
+                3 => sample.p_lens.y = bad,
+                _ => sample.time = bad,
+            }
+            assert!(
+                camera.generate_ray(&sample).is_none(),
+                "{bad} in field {field}"
+            );
+            assert!(
+                camera.generate_ray_differential(&sample).is_none(),
+                "{bad} in field {field}"
+            );
+        }
+    }
+}
