@@ -24,9 +24,10 @@
 //! +y up, +x the image's right, which makes the camera frame left-handed in a right-handed
 //! world.
 //!
-//! Speed: rays do not go through the 4x4 chain one by one. Each model folds the film-to-camera
-//! map and the pose's affine part into a few world-space constants (for a perspective pinhole,
-//! the direction is `d_x * x + d_y * y + d_1`, then one normalisation), computed once for a
+//! Speed: rays do not go through the 4x4 chain one by one. Each model reduces the film-to-camera
+//! map and the pose's affine part to a few constants (for a perspective pinhole, the film point
+//! `q` on the camera plane z = 1 is affine in raster x, y and the world direction is `R q`, then
+//! one normalisation), computed once for a
 //! fixed pose and once per ray for a moving one, with the same function, so a moving camera
 //! at a keyframe's time gives the fixed camera's rays bit for bit. The transforms stay the
 //! reference: [`ProjectiveCamera`] exposes them, and `project` uses them.

@@ -27,21 +27,32 @@ use obscura_space::{Camera as CameraSpace, Point2, Point3, Raster, Ray, Vector3,
 #[derive(Debug, Clone)]
 pub struct OrthographicCamera {
     projective: ProjectiveCamera,
+    /// Film to camera x and y in world units: `(x', y') = scale * p_raster + offset`,
+    /// pose-independent (see `ProjectiveCamera::film_map`).
+    film_from_raster: (Vec3A, Vec3A),
     /// The fast path's constants of a fixed pose.
     fixed: Option<OrthographicMap>,
 }
 
-/// Per-pose constants of the fast path. The film point's ray starts at world
-/// `eye + R (x', y', 0) = o_x * x + o_y * y + o_1` (affine in raster x, y) and runs along `R z`.
+/// Per-pose constants of the fast path. The film point `(x', y')` (camera space, from
+/// [`OrthographicCamera`]'s pose-independent `film_from_raster`) has its ray start at world
+/// `eye + R (x', y', 0) = eye + x * x' + y * y'` and run along `R z`.
+///
+/// Precision: the origin's camera z is 0 up to the rounding of that sum, at most about
+/// `3 * 2^-24 (|x'| + |y'| + |eye|)`, small against the origin's own size. (An earlier form
+/// folded the film offset into `o_1 = eye + R (offset, 0)`, whose rounding, up to
+/// `2^-24 |offset|` with `|offset|` the window's half-extent, reached camera z too.)
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct OrthographicMap {
-    o_x: Vec3A,
-    o_y: Vec3A,
-    o_1: Vec3A,
+    eye: Vec3A,
     /// World images of camera +x, +y and +z.
+    x: Vec3A,
+    y: Vec3A,
+    axis: Vec3A,
+    /// The aperture's axes: `x` and `y` again (as in `PerspectiveMap`, separate copies keep
+    /// LLVM from loading them into registers before the lens test).
     lens_x: Vec3A,
     lens_y: Vec3A,
-    axis: Vec3A,
     /// `axis` normalised, and the distances to camera z = near and far along it: exactly
     /// `[near, far]` when the pose is rigid (`|axis|` is 1 up to rounding).
     direction: Vec3A,
@@ -70,6 +81,7 @@ impl OrthographicCamera {
         let projective =
             ProjectiveCamera::build(base, lens, (screen_from_camera, camera_from_screen), false)?;
         let mut camera = OrthographicCamera {
+            film_from_raster: projective.film_map(1.0),
             projective,
             fixed: None,
         };
@@ -113,8 +125,6 @@ impl CameraRayModel for OrthographicCamera {
     #[inline]
     fn world_map(&self, frame: &PoseFrame) -> OrthographicMap {
         let base = self.projective.base();
-        // Film to camera (x', y', 0) in world units, then eye + x' R.x + y' R.y.
-        let (scale, offset) = self.projective.screen_from_raster_xy();
         let axis = Vec3A::from(frame.z.as_vec3());
         let length = axis.length();
         let (t_min, t_max) = if is_unit_length(length) {
@@ -123,11 +133,9 @@ impl CameraRayModel for OrthographicCamera {
             (base.near * length, base.far * length)
         };
         OrthographicMap {
-            o_x: (frame.x * scale.x).as_vec3().into(),
-            o_y: (frame.y * scale.y).as_vec3().into(),
-            o_1: (frame.eye + frame.x * offset.x + frame.y * offset.y)
-                .as_vec3()
-                .into(),
+            eye: frame.eye.as_vec3().into(),
+            x: frame.x.as_vec3().into(),
+            y: frame.y.as_vec3().into(),
             lens_x: frame.x.as_vec3().into(),
             lens_y: frame.y.as_vec3().into(),
             axis,
@@ -147,7 +155,11 @@ impl CameraRayModel for OrthographicCamera {
     #[inline(always)]
     fn ray_world(&self, map: &OrthographicMap, p_film: Point2<Raster>, u_lens: Vec2) -> Ray<World> {
         let lens = self.projective.lens();
-        let p_center = map.o_x * p_film.x + map.o_y * p_film.y + map.o_1;
+        // The film point in camera space (see OrthographicMap on precision), then its world
+        // position eye + R (x', y', 0).
+        let (film_scale, film_offset) = self.film_from_raster;
+        let q = film_scale * Vec3A::new(p_film.x, p_film.y, 0.0) + film_offset;
+        let p_center = map.x * q.x + map.y * q.y + map.eye;
         if !lens.is_thin_lens() {
             return Ray {
                 origin: Point3::from_glam(Vec3::from(p_center)),

@@ -3,7 +3,7 @@
 
 use crate::camera::{CameraBase, ThinLens};
 use crate::error::CameraError;
-use glam::{DMat4, DVec2, DVec3};
+use glam::{DMat4, DVec2, DVec3, Vec3A};
 use obscura_space::{
     Camera as CameraSpace, Ndc, Point2, Point3, Raster, Ray, Screen, Transform, Vector3,
 };
@@ -178,12 +178,25 @@ impl ProjectiveCamera {
         self.camera_from_raster.inverse()
     }
 
-    /// Screen x and y of a raster position as `scale * p_raster + offset`, in f64: `(scale,
-    /// offset)`. Both models' fast paths start from it (screen z does not enter: the map is
-    /// affine in x and y).
-    #[inline]
-    pub(crate) fn screen_from_raster_xy(&self) -> (DVec2, DVec2) {
-        self.screen_from_raster_xy
+    /// The fast paths' film map: screen x and y of a raster position times `factor` (the
+    /// perspective model's `1 / s`, giving the film point on the plane z = 1; 1 for the
+    /// orthographic model) as `scale * p_raster + offset`, composed in f64 and rounded once,
+    /// in the first two lanes of `(scale, offset)` (the third 0) so that it is one SIMD
+    /// multiply and add per ray.
+    ///
+    /// Why the models apply it per ray in camera space rather than fold it into their world
+    /// constants: `offset` reaches the window's half-extent (e.g. 323 on a 3 x 969 film)
+    /// while the film point near the window's centre is ~1, so the affine map cancels. In
+    /// camera space that cancellation only moves the film point within its plane, by an f32
+    /// step of the raster position; folded into world constants it cancelled in all three
+    /// world components, the view axis included, and the clip range (camera z) was off by
+    /// about `2^-24 * offset`.
+    pub(crate) fn film_map(&self, factor: f64) -> (Vec3A, Vec3A) {
+        let (scale, offset) = self.screen_from_raster_xy;
+        (
+            (scale * factor).as_vec2().extend(0.0).into(),
+            (offset * factor).as_vec2().extend(0.0).into(),
+        )
     }
 
     /// The film point of a raster position in camera space, on the near plane (screen z = 0).

@@ -19,7 +19,7 @@ fn camera_dir(camera: &EnvironmentCamera, p: Point2<obscura_space::Raster>) -> g
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(512))]
+    #![proptest_config(crate::cases(512))]
 
     /// Directions are unit; the top half looks up (+y), the right half right (+x), the middle
     /// columns forward (+z); and the ray runs over [near, far] from the eye.

@@ -21,6 +21,16 @@ use obscura_camera::{
 use obscura_space::{Point3, Vector3, World};
 use proptest::prelude::*;
 
+/// A proptest config of `cases` cases, unless `PROPTEST_CASES` is set (for stress runs such as
+/// `PROPTEST_CASES=20000 cargo test -p obscura-camera --test it clip`): proptest reads that
+/// variable only in `Config::default()`, and `with_cases` would override it.
+pub fn cases(cases: u32) -> ProptestConfig {
+    let from_env = std::env::var("PROPTEST_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok());
+    ProptestConfig::with_cases(from_env.unwrap_or(cases))
+}
+
 /// Asserts two glam vectors agree within `tol`.
 #[track_caller]
 pub fn assert_close3(a: glam::Vec3, b: glam::Vec3, tol: f32) {

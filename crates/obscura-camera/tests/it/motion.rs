@@ -22,7 +22,7 @@ fn models(base: CameraBase) -> Vec<AnyCamera> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(128))]
+    #![proptest_config(crate::cases(128))]
 
     #[test]
     fn moving_camera_matches_its_keyframes(

@@ -6,7 +6,7 @@ use obscura_camera::{
     AnyCamera, Camera, CameraSample, FovAxis, OrthographicCamera, PerspectiveCamera,
     ProjectiveCamera, ThinLens,
 };
-use obscura_space::{Point2, Point3, Raster};
+use obscura_space::{Point2, Point3, Raster, Vector3};
 use proptest::prelude::*;
 
 /// The projective chain of a projective camera.
@@ -41,7 +41,7 @@ fn raster_per_unit(camera: &AnyCamera, ray: &obscura_space::Ray<obscura_space::W
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(512))]
+    #![proptest_config(crate::cases(512))]
 
     /// raster -> camera -> raster, through `camera_from_raster` and `raster_from_camera`.
     #[test]
@@ -115,8 +115,19 @@ proptest! {
                 assert_close3(ra.direction.to_glam(), rb.direction.to_glam(), 1e-6);
                 let view = pose.vector(obscura_space::Vector3::new(0.0, 0.0, 1.0));
                 assert_close3(ra.direction.to_glam(), view.to_glam(), 1e-6);
+                // The origin is on the camera plane z = 0 up to f32 rounding of a point that may
+                // lie ~2000 units off axis (the window's half-extent on a 1999 x 1 film), where
+                // one f32 step is 1.2e-4: so the allowance is relative to the points' sizes,
+                // 1e-6 = 16.8u per unit (u = 2^-24). Budget, with q = (x', y', 0) the camera-space
+                // origin and o its world image: the fast path's `R.x x' + R.y y' + eye` rounds
+                // by at most 3u (|q| sqrt 2 + |eye|) and |eye| <= |o| + |q|; this test's
+                // `camera_from_world` rounds by ~4u (|o| + |eye|); the stored pose and its
+                // inverse disagree by ~2u (|o| + |eye|). Total <= 15u (|o| + |q|).
                 let camera_from_world = pose.inverse();
-                prop_assert!(camera_from_world.point(ra.origin).z.abs() < 1e-4);
+                let o_camera = camera_from_world.point(ra.origin);
+                let allowance = 1e-6
+                    * (1.0 + ra.origin.to_vector().length() + o_camera.to_vector().length());
+                prop_assert!(o_camera.z.abs() <= allowance, "origin z {} allowance {allowance}", o_camera.z);
             }
         }
     }
@@ -124,22 +135,87 @@ proptest! {
     /// Near and far clipping: the camera z of ray.at(t_min) is near and of ray.at(t_max) far.
     #[test]
     fn clip_range_is_camera_z(camera in projective_strategy(false), fx in 0f32..1.0, fy in 0f32..1.0) {
-        let p_film = raster_in(camera.film().resolution(), fx, fy);
-        let ray = camera.generate_ray(&CameraSample::at(p_film)).unwrap().ray;
-        let chain = chain(&camera);
-        let (near, far) = (chain.base().near, chain.base().far);
-        // In camera space (the pose is rigid, so t is the same distance there).
-        let camera_from_world = camera.world_from_camera().at(0.0).inverse();
-        let r_camera = camera_from_world.ray(ray);
-        let z_near = r_camera.origin.z + r_camera.direction.z * ray.t_min;
-        let z_far = r_camera.origin.z + r_camera.direction.z * ray.t_max;
-        // Absolute error of the transformed origin (eye up to ~17 away) plus the relative
-        // rounding of d.z, which grows as the ray turns away from the view axis.
-        let rel = 1e-6 / r_camera.direction.z;
-        // (Orthographic origins lie up to the window's size off axis.)
-        let abs = 1e-6 * (1.0 + ray.origin.to_vector().length() + r_camera.origin.to_vector().length());
-        prop_assert!((z_near - near).abs() <= abs + rel * near, "near {near} got {z_near}");
-        prop_assert!((z_far - far).abs() <= abs + rel * far, "far {far} got {z_far}");
+        check_clip_range(&camera, raster_in(camera.film().resolution(), fx, fy))?;
+    }
+}
+
+/// The camera z of `ray.at(t_min)` is near and of `ray.at(t_max)` far, for the pinhole ray of
+/// `p_film`, up to f32 rounding.
+///
+/// The allowance: an absolute part for the transformed origin (eye up to ~17 away), and a
+/// relative part `1e-6 / d.z = 1e-6 |q|` (`q` the film point on the camera plane z = 1,
+/// `d.z = 1 / |q|` for the unit direction). The perspective fast path's error budget (see
+/// `PerspectiveMap`): its rounding in `R q` is at most `3 sqrt(3) u |q|` along the view axis
+/// (u = 2^-24), the stored pose and the two roundings of `t` and the direction add ~4u, and
+/// this test's own `camera_from_world` rounds `d.z` by up to `3u`, i.e. `3u |q|` relative.
+/// Total <= `8.2u |q| + 4u <= 12.2u |q| = 7.3e-7 |q|`, inside `1e-6 |q|`.
+/// (Orthographic origins lie up to the window's size off axis: the absolute part covers them.)
+fn check_clip_range(camera: &AnyCamera, p_film: Point2<Raster>) -> Result<(), TestCaseError> {
+    let ray = camera.generate_ray(&CameraSample::at(p_film)).unwrap().ray;
+    let chain = chain(camera);
+    let (near, far) = (chain.base().near, chain.base().far);
+    // In camera space (the pose is rigid, so t is the same distance there).
+    let camera_from_world = camera.world_from_camera().at(0.0).inverse();
+    let r_camera = camera_from_world.ray(ray);
+    let z_near = r_camera.origin.z + r_camera.direction.z * ray.t_min;
+    let z_far = r_camera.origin.z + r_camera.direction.z * ray.t_max;
+    let rel = 1e-6 / r_camera.direction.z;
+    let abs = 1e-6 * (1.0 + ray.origin.to_vector().length() + r_camera.origin.to_vector().length());
+    prop_assert!(
+        (z_near - near).abs() <= abs + rel * near,
+        "near {near} got {z_near} at {p_film:?}"
+    );
+    prop_assert!(
+        (z_far - far).abs() <= abs + rel * far,
+        "far {far} got {z_far} at {p_film:?}"
+    );
+    Ok(())
+}
+
+/// The clip range on tall films, where the film point's offset in camera space (up to the
+/// window's half-extent, over `s` for perspective) is much longer than the centre rows' film
+/// point (~1): the cases the property found (issue 9). Perspective: 4 x 528 film, fov along
+/// x, offset up to 132 / s = 74.7. Orthographic: 3 x 969 film, offset up to 323. Sweeps
+/// the middle rows in quarter pixels, every column, with the failing cases' poses.
+#[test]
+fn clip_range_on_a_tall_film() {
+    // Camera z along (0.29, 0.52, -0.81), camera x in world xy.
+    let perspective_look = (
+        Point3::new(0.0, 0.0, 8.132996),
+        Point3::new(0.2917941, 0.51542217, 8.132996 - 0.8057272),
+        Vector3::new(0.0, 0.0, -1.0),
+    );
+    // Camera z along (-0.65, -0.12, -0.75), y along (-0.55, 0.75, 0.36), eye 3.6 from 0.
+    let orthographic_look = (
+        Point3::new(-3.4135153, 1.1702431, 0.0),
+        Point3::new(-3.4135153 - 0.6539908, 1.1702431 - 0.12455316, -0.74617857),
+        Vector3::new(-0.5524943, 0.75241345, 0.35864165),
+    );
+    for (near, far) in [(0.001f32, 1.0e30f32), (0.1, 1000.0)] {
+        let perspective: AnyCamera = PerspectiveCamera::new(
+            base_at(perspective_look, [4, 528], None, near, far),
+            58.985527,
+            FovAxis::X,
+            ThinLens::PINHOLE,
+        )
+        .unwrap()
+        .into();
+        let orthographic: AnyCamera = OrthographicCamera::new(
+            base_at(orthographic_look, [3, 969], None, near, far),
+            ThinLens::PINHOLE,
+        )
+        .unwrap()
+        .into();
+        for camera in [perspective, orthographic] {
+            let [w, h] = camera.film().resolution();
+            for j in 0..4 * 40 {
+                for i in 0..4 * w {
+                    let y = (h / 2 - 20) as f32 + j as f32 * 0.25;
+                    let p_film = Point2::new(i as f32 * 0.25, y);
+                    check_clip_range(&camera, p_film).unwrap();
+                }
+            }
+        }
     }
 }
 

@@ -34,7 +34,7 @@ fn lens_of(camera: &AnyCamera) -> ThinLens {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(256))]
+    #![proptest_config(crate::cases(256))]
 
     /// Every lens sample of one film point meets the pinhole ray of that point on the plane of
     /// focus (camera z = focal distance), and projects back to the film point there.
@@ -64,8 +64,12 @@ proptest! {
             let ray = camera.generate_ray(&sample).unwrap().ray;
             prop_assert!((ray.direction.length() - 1.0).abs() < 1e-5);
             let r = camera_from_world.ray(ray);
-            // The lens point is on z = 0, within the aperture around the pinhole origin.
-            prop_assert!(r.origin.z.abs() < 1e-4);
+            // The lens point is on z = 0, within the aperture around the pinhole origin. Up to
+            // rounding relative to the points' sizes (orthographic origins lie up to ~2000 off
+            // axis, where one f32 step is 1.2e-4): 1e-6 = 16.8u per unit, the budget of
+            // `perspective_converge_orthographic_parallel` plus ~1u for adding the lens offset.
+            let allowance = 1e-6 * (1.0 + ray.origin.to_vector().length() + r.origin.to_vector().length());
+            prop_assert!(r.origin.z.abs() <= allowance, "lens point z {} allowance {allowance}", r.origin.z);
             let offset = glam::Vec2::new(r.origin.x - r0.origin.x, r.origin.y - r0.origin.y);
             prop_assert!(offset.length() <= lens.radius * (1.0 + 1e-4) + 1e-4);
             assert_close3(at_focus(r).to_glam(), p_focus.to_glam(), tol);
