@@ -3,7 +3,9 @@
 //! Everything here works in one space (whichever the caller's ray is in) and knows nothing of
 //! instances; the scene carries rays and hits between spaces.
 
-use glam::{Mat4, Vec3, Vec3A};
+#[cfg(test)]
+use glam::Vec3A;
+use glam::{Mat4, Vec3};
 
 /// pbrt's `gamma(n) = n * eps / (1 - n * eps)`, with `eps` half an ulp of 1: a bound on the
 /// relative error of `n` chained roundings.
@@ -21,8 +23,9 @@ pub(crate) struct TriangleHit {
     pub b2: f32,
 }
 
-/// Moeller-Trumbore ray-triangle intersection, two-sided, for `t` in `[t_min, t_max]`.
-#[inline(always)]
+/// Moeller-Trumbore ray-triangle intersection, two-sided, for `t` in `[t_min, t_max]`: the
+/// scalar reference for the four-wide test the BVH uses (`wide`), kept for the tests.
+#[cfg(test)]
 pub(crate) fn intersect_triangle(
     origin: Vec3A,
     direction: Vec3A,

@@ -55,6 +55,7 @@ mod mesh;
 mod obj;
 mod scene;
 pub mod testmesh;
+mod wide;
 
 pub use error::AccelError;
 pub use hit::{Hit, SHADOW_EPSILON};

@@ -1,12 +1,14 @@
 //! Shapes, instances, the two-level BVH and the ray queries.
 
 use crate::error::AccelError;
+
 use crate::geom::{
-    QuadHit, TriangleHit, gamma, intersect_quad, intersect_sphere, intersect_triangle,
-    object_space_error, transform_point_with_error,
+    QuadHit, TriangleHit, gamma, intersect_quad, intersect_sphere, object_space_error,
+    transform_point_with_error,
 };
 use crate::hit::Hit;
 use crate::mesh::TriangleMesh;
+use crate::wide::{WideBvh, WideHit};
 use glam::{Vec2, Vec3, Vec3A};
 use obscura_space::{
     AnimatedTransform, Bounds3, Normal3, Object, Point3, Ray, Transform, Vector3, World,
@@ -14,9 +16,8 @@ use obscura_space::{
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::CwBvh;
-use obvhs::cwbvh::builder::{build_cwbvh, build_cwbvh_from_tris};
+use obvhs::cwbvh::builder::build_cwbvh;
 use obvhs::ray::RayHit;
-use obvhs::triangle::Triangle;
 use std::collections::HashMap;
 use std::sync::Arc;
 use std::time::Duration;
@@ -204,7 +205,7 @@ impl SceneBuilder {
         let mut statics = Vec::with_capacity(instance_count);
         let mut flat_tris: Vec<[Vec3A; 3]> = Vec::new();
         let mut flat_ids: Vec<[u32; 2]> = Vec::new();
-        let mut blases: Vec<Blas> = Vec::new();
+        let mut blases: Vec<WideBvh> = Vec::new();
         let mut blas_of_mesh: HashMap<*const TriangleMesh, usize> = HashMap::new();
 
         for (instance, (shape, placement)) in self.instances.into_iter().enumerate() {
@@ -235,7 +236,7 @@ impl SceneBuilder {
                             let corners =
                                 mesh.corners(i).map(|p| Vec3A::from(m.transform_point3(p)));
                             flat_tris.push(corners);
-                            flat_ids.push([instance, i as u32]);
+                            flat_ids.push([i as u32, instance]);
                         }
                     }
                     Placement::Moving(world_from_object) => {
@@ -244,7 +245,8 @@ impl SceneBuilder {
                             let tris = (0..mesh.triangle_count())
                                 .map(|i| mesh.corners(i).map(Vec3A::from))
                                 .collect::<Vec<_>>();
-                            blases.push(Blas::build(tris, params));
+                            let ids = (0..tris.len() as u32).map(|i| [i, 0]).collect::<Vec<_>>();
+                            blases.push(WideBvh::build(&tris, &ids, params));
                             blases.len() - 1
                         });
                         item_bounds.push(world_from_object.motion_bounds(mesh.bounds()));
@@ -305,9 +307,7 @@ impl SceneBuilder {
             );
             item_bounds.push(b);
             items.push(Item::Flat);
-            let blas = Blas::build(flat_tris, params);
-            let ids = blas.prims.iter().map(|&i| flat_ids[i as usize]).collect();
-            Some((blas, ids))
+            Some(WideBvh::build(&flat_tris, &flat_ids, params))
         };
         if item_bounds
             .iter()
@@ -362,70 +362,13 @@ pub struct Scene {
     items: Vec<Item>,
     /// The top-level BVH and its slot -> item map; `None` for zero or one item.
     tlas: Option<(CwBvh, Vec<u32>)>,
-    /// All static mesh triangles in world space, with (instance, triangle) per BVH slot.
-    flat: Option<(Blas, Vec<[u32; 2]>)>,
-    blases: Vec<Blas>,
+    /// All static mesh triangles in world space; hits carry (triangle, instance).
+    flat: Option<WideBvh>,
+    /// One object-space BVH per distinct moving mesh.
+    blases: Vec<WideBvh>,
     meshes: Vec<Option<Arc<TriangleMesh>>>,
     statics: Vec<Option<Transform<World, Object>>>,
     bounds: Bounds3<World>,
-}
-
-/// A per-mesh BVH with its triangles stored in BVH slot order.
-#[derive(Debug)]
-struct Blas {
-    bvh: CwBvh,
-    tris: Vec<[Vec3A; 3]>,
-    /// The input index of the triangle in each slot.
-    prims: Vec<u32>,
-}
-
-impl Blas {
-    fn build(tris: Vec<[Vec3A; 3]>, params: BvhBuildParams) -> Blas {
-        let input = tris
-            .iter()
-            .map(|&[v0, v1, v2]| Triangle { v0, v1, v2 })
-            .collect::<Vec<_>>();
-        let bvh = build_cwbvh_from_tris(&input, params, &mut Duration::default());
-        let prims = bvh.primitive_indices.clone();
-        let tris = prims.iter().map(|&i| tris[i as usize]).collect();
-        Blas { bvh, tris, prims }
-    }
-
-    /// The closest triangle hit in `[t_min, t_max]`: its slot and hit.
-    #[inline]
-    fn closest(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> Option<(usize, TriangleHit)> {
-        let ray = obvhs::ray::Ray::new(o, d, t_min, t_max);
-        let mut ray_hit = RayHit::none();
-        let mut best = None;
-        self.bvh.ray_traverse(ray, &mut ray_hit, |r, slot| {
-            match intersect_triangle(r.origin, r.direction, r.tmin, r.tmax, &self.tris[slot]) {
-                Some(h) => {
-                    best = Some((slot, h));
-                    h.t
-                }
-                None => f32::INFINITY,
-            }
-        });
-        best
-    }
-
-    /// True when any triangle is hit in `[t_min, t_max]`.
-    #[inline]
-    fn any(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> bool {
-        let ray = obvhs::ray::Ray::new(o, d, t_min, t_max);
-        let mut hit = false;
-        self.bvh.ray_traverse_miss(ray, |r, slot| {
-            match intersect_triangle(r.origin, r.direction, r.tmin, r.tmax, &self.tris[slot]) {
-                Some(_) => {
-                    hit = true;
-                    // Below any tmax: stops the traversal.
-                    f32::NEG_INFINITY
-                }
-                None => f32::INFINITY,
-            }
-        });
-        hit
-    }
 }
 
 #[derive(Debug, Clone)]
@@ -482,14 +425,14 @@ enum Item {
 /// What a traversal found, enough to build the [`Hit`] afterwards.
 #[derive(Clone, Copy, Debug)]
 enum Found {
+    /// A flattened triangle; the ids are (triangle, instance).
     Flat {
-        slot: usize,
-        tri: TriangleHit,
+        hit: WideHit,
     },
+    /// A triangle of a moving mesh, in object space; the first id is the triangle.
     Moving {
         item: usize,
-        slot: usize,
-        tri: TriangleHit,
+        hit: WideHit,
     },
     Sphere {
         item: usize,
@@ -504,7 +447,7 @@ enum Found {
 impl Found {
     fn t(&self) -> f32 {
         match self {
-            Found::Flat { tri, .. } | Found::Moving { tri, .. } => tri.t,
+            Found::Flat { hit } | Found::Moving { hit, .. } => hit.tri.t,
             Found::Sphere { t, .. } => *t,
             Found::Quad { quad, .. } => quad.t,
         }
@@ -602,14 +545,20 @@ impl Scene {
         self.meshes.len()
     }
 
+    /// Bytes held by the triangle BVHs (nodes and leaf triangles; the meshes themselves and
+    /// the few-box top level are not counted), for memory budgets and the performance notes.
+    pub fn bvh_bytes(&self) -> usize {
+        let flat = self.flat.as_ref().map_or(0, WideBvh::heap_bytes);
+        flat + self.blases.iter().map(WideBvh::heap_bytes).sum::<usize>()
+    }
+
     /// The closest hit on one item with `t` in `[r.t_min, t_max]`.
     #[inline]
     fn intersect_item(&self, item: usize, r: &PlainRay, t_max: f32) -> Option<Found> {
         match &self.items[item] {
             Item::Flat => {
-                let (blas, _) = self.flat.as_ref()?;
-                let (slot, tri) = blas.closest(r.o, r.d, r.t_min, t_max)?;
-                Some(Found::Flat { slot, tri })
+                let hit = self.flat.as_ref()?.closest(r.o, r.d, r.t_min, t_max)?;
+                Some(Found::Flat { hit })
             }
             Item::MovingMesh {
                 blas,
@@ -618,8 +567,8 @@ impl Scene {
             } => {
                 let object_from_world = world_from_object.at(r.time).inverse();
                 let (o, d) = to_object(&object_from_world, r);
-                let (slot, tri) = self.blases[*blas].closest(o, d, r.t_min, t_max)?;
-                Some(Found::Moving { item, slot, tri })
+                let hit = self.blases[*blas].closest(o, d, r.t_min, t_max)?;
+                Some(Found::Moving { item, hit })
             }
             Item::Analytic { shape, xform, .. } => {
                 let object_from_world = xform.at(r.time).inverse();
@@ -650,7 +599,7 @@ impl Scene {
             Item::Flat => self
                 .flat
                 .as_ref()
-                .is_some_and(|(blas, _)| blas.any(r.o, r.d, r.t_min, r.t_max)),
+                .is_some_and(|blas| blas.any(r.o, r.d, r.t_min, r.t_max)),
             Item::MovingMesh {
                 blas,
                 world_from_object,
@@ -667,31 +616,24 @@ impl Scene {
     /// Builds the full world-space hit record from what the traversal found.
     fn finish(&self, r: &PlainRay, found: Found) -> Hit {
         match found {
-            Found::Flat { slot, tri } => {
-                let (blas, ids) = self
-                    .flat
-                    .as_ref()
-                    .expect("a flat hit implies flat triangles");
-                let [instance, primitive] = ids[slot];
+            Found::Flat { hit } => {
+                let [primitive, instance] = hit.ids;
                 let world_from_object =
                     self.statics[instance as usize].expect("flattened meshes are static");
                 let mesh = self.meshes[instance as usize]
                     .as_ref()
                     .expect("flattened instances are meshes");
-                let corners = blas.tris[slot].map(Vec3::from);
-                let (p, p_error) = barycentric_point(&corners, tri);
-                // The world corners already carry the transform: (M a) x (M b) =
+                let (p, p_error) = edge_point(&hit);
+                // The world edges already carry the transform: (M a) x (M b) =
                 // det(M) M^-T (a x b), so flip for a mirroring transform to match the inverse
                 // transpose of the object-space winding normal.
-                let mut n_geo = (corners[1] - corners[0])
-                    .cross(corners[2] - corners[0])
-                    .normalize();
+                let mut n_geo = hit.e1.cross(hit.e2).normalize();
                 if world_from_object.swaps_handedness() {
                     n_geo = -n_geo;
                 }
                 self.triangle_hit(
                     r,
-                    tri,
+                    hit.tri,
                     p,
                     p_error,
                     n_geo,
@@ -701,22 +643,20 @@ impl Scene {
                     &world_from_object,
                 )
             }
-            Found::Moving { item, slot, tri } => {
+            Found::Moving { item, hit } => {
                 let Item::MovingMesh {
                     instance,
-                    blas,
                     world_from_object,
+                    ..
                 } = &self.items[item]
                 else {
                     unreachable!("Found::Moving comes from a moving mesh")
                 };
-                let primitive = self.blases[*blas].prims[slot];
                 let mesh = self.meshes[*instance as usize]
                     .as_ref()
                     .expect("moving mesh instances are meshes");
                 let world_from_object = world_from_object.at(r.time);
-                let corners = mesh.corners(primitive as usize);
-                let (p_object, err_object) = barycentric_point(&corners, tri);
+                let (p_object, err_object) = edge_point(&hit);
                 let (p, p_error) =
                     transform_point_with_error(&world_from_object.matrix(), p_object, err_object);
                 let p_error = p_error
@@ -725,16 +665,15 @@ impl Scene {
                         &world_from_object.inverse_matrix(),
                         p,
                     );
-                let n_object = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
-                let n_geo = normal_to_world(&world_from_object, n_object);
+                let n_geo = normal_to_world(&world_from_object, hit.e1.cross(hit.e2));
                 self.triangle_hit(
                     r,
-                    tri,
+                    hit.tri,
                     p,
                     p_error,
                     n_geo,
                     mesh,
-                    primitive,
+                    hit.ids[0],
                     *instance,
                     &world_from_object,
                 )
@@ -912,13 +851,16 @@ fn normal_to_world(world_from_object: &Transform<World, Object>, n_object: Vec3)
         .normalize()
 }
 
-/// The point `b0 p0 + b1 p1 + b2 p2` and pbrt's error bound for it, `gamma(7) sum |b_i p_i|`.
+/// The hit point `v0 + b1 e1 + b2 e2` on the triangle as the BVH stores it, and a bound on its
+/// error: the sum rounds at most three times and each edge was rounded once when it was
+/// stored, so `gamma(4) (|v0| + |b1 e1| + |b2 e2|)` covers it; pbrt's `gamma(7)` on the same
+/// terms is kept for margin (the barycentrics themselves carry error within the plane, which
+/// moves the point along the surface, not off it).
 #[inline]
-fn barycentric_point(corners: &[Vec3; 3], tri: TriangleHit) -> (Vec3, Vec3) {
-    let b = [1.0 - tri.b1 - tri.b2, tri.b1, tri.b2];
-    let terms = [corners[0] * b[0], corners[1] * b[1], corners[2] * b[2]];
-    let p = terms[0] + terms[1] + terms[2];
-    let err = gamma(7) * (terms[0].abs() + terms[1].abs() + terms[2].abs());
+fn edge_point(hit: &WideHit) -> (Vec3, Vec3) {
+    let (a, b, c) = (hit.v0, hit.e1 * hit.tri.b1, hit.e2 * hit.tri.b2);
+    let p = a + b + c;
+    let err = gamma(7) * (a.abs() + b.abs() + c.abs());
     (p, err)
 }
 

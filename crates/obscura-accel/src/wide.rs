@@ -1,0 +1,682 @@
+//! The triangle BVH: obvhs builds the tree, this module lays it out for SIMD and traverses it.
+//!
+//! obvhs builds a binary BVH (PLOC, then reinsertion, with the [`BvhBuildParams`] preset); it is
+//! collapsed here into nodes of up to eight children whose boxes sit in structure-of-arrays
+//! form, one `Vec4` lane per child, so one ray tests eight boxes in two registers' worth of SSE
+//! instructions. Every subtree of at most four triangles becomes one leaf *packet*: the
+//! triangles' first vertices and edges, again one lane per triangle, tested together by a
+//! four-wide Möller–Trumbore.
+//!
+//! Why not obvhs's own traversal: its compressed wide BVH (CWBVH) unpacks eight quantised child
+//! boxes per node and tests leaf triangles one at a time, which profiling put at 40% of a query
+//! (docs/performance.md). A traversal over a 1M-triangle mesh is bound by memory latency, one
+//! cache miss per node visited, so the wide nodes (half the depth of a four-wide tree) matter
+//! most; nodes and packets are aligned to cache lines so none straddles one line more than it
+//! must.
+//!
+//! Everything is safe Rust: the lanes are glam's `Vec4`, which is an SSE register on x86-64.
+
+use crate::geom::TriangleHit;
+use glam::{BVec4A, Vec3, Vec3A, Vec4};
+use obvhs::BvhBuildParams;
+use obvhs::aabb::Aabb;
+use obvhs::bvh2::Bvh2;
+use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
+use obvhs::ploc::PlocBuilder;
+use obvhs::splits::split_aabbs_preset;
+use obvhs::triangle::Triangle;
+use std::cell::Cell;
+
+thread_local! {
+    /// Each thread's traversal stacks, kept between queries so a query neither allocates nor
+    /// clears a fixed array.
+    static CLOSEST_STACK: Cell<Vec<(u32, f32)>> = const { Cell::new(Vec::new()) };
+    static ANY_STACK: Cell<Vec<u32>> = const { Cell::new(Vec::new()) };
+}
+
+/// Set in a child reference that names a leaf packet rather than a node.
+const LEAF: u32 = 1 << 31;
+/// The child reference of an unused lane (its box is empty, so it is never entered).
+const EMPTY: u32 = u32::MAX;
+/// Children per node: two SIMD registers' worth.
+const ARITY: usize = 8;
+/// Triangles per leaf packet (the SIMD width).
+const WIDTH: usize = 4;
+/// pbrt's `gamma(3)`: the relative error of a slab distance `(b - o) * (1 / d)`; the far
+/// distance is pushed out by twice this so rounding never culls a box the ray touches.
+const SLAB_SLACK: f32 = 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
+
+/// Eight children's boxes, one lane per child (children 0-3 in the first register, 4-7 in
+/// the second), and what each child is: 224 bytes, aligned to start a cache line so a node
+/// costs four lines, never five.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+struct Node {
+    /// `[min_x, max_x, min_y, max_y, min_z, max_z]`; an unused lane has min +inf, max -inf.
+    bounds: [[Vec4; 2]; 6],
+    /// A node index, `LEAF | packet index`, or `EMPTY`.
+    child: [u32; ARITY],
+}
+
+/// Up to four triangles, one lane each: the first vertex and the two edges from it.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+struct Packet {
+    v0: [Vec4; 3],
+    e1: [Vec4; 3],
+    e2: [Vec4; 3],
+    /// The caller's two ids of the triangle in each lane (padding lanes are degenerate and
+    /// never hit): a hit is reported without touching any other array.
+    ids: [[u32; WIDTH]; 2],
+}
+
+/// A hit found by [`WideBvh::closest`]: the triangle's ids and the triangle itself as the BVH
+/// stores it (first vertex and the two edges from it), so the caller needs no further lookup.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct WideHit {
+    /// The two ids given for the triangle at build time.
+    pub ids: [u32; 2],
+    /// Distance and barycentrics.
+    pub tri: TriangleHit,
+    /// `v0`, `v1 - v0`, `v2 - v0`, exactly as the intersection test used them.
+    pub v0: Vec3,
+    pub e1: Vec3,
+    pub e2: Vec3,
+}
+
+/// An eight-wide BVH with four-wide leaf packets over a list of triangles.
+#[derive(Clone, Debug)]
+pub(crate) struct WideBvh {
+    nodes: Vec<Node>,
+    packets: Vec<Packet>,
+    /// A node index, a leaf reference, or `EMPTY` for no triangles.
+    root: u32,
+}
+
+/// A ray prepared for the box tests: splatted origin, reciprocal direction and near-plane lanes.
+struct Prepared {
+    o: [Vec4; 3],
+    d: [Vec4; 3],
+    inv: [Vec4; 3],
+    /// 1 where the direction is negative (the box's max plane is met first), else 0.
+    near: [usize; 3],
+}
+
+impl Prepared {
+    #[inline(always)]
+    fn new(o: Vec3A, d: Vec3A) -> Prepared {
+        // A zero component would give 0 * inf = NaN on a slab through the origin; a tiny
+        // stand-in of the same sign gives the same slab answer with finite arithmetic.
+        let safe = |c: f32| {
+            if c.abs() < 1e-30 {
+                1e-30f32.copysign(c)
+            } else {
+                c
+            }
+        };
+        let inv = [1.0 / safe(d.x), 1.0 / safe(d.y), 1.0 / safe(d.z)];
+        Prepared {
+            o: [Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z)],
+            d: [Vec4::splat(d.x), Vec4::splat(d.y), Vec4::splat(d.z)],
+            inv: inv.map(Vec4::splat),
+            near: inv.map(|i| usize::from(i < 0.0)),
+        }
+    }
+
+    /// The entry distance of each child's box and the mask of children the ray enters within
+    /// `[t_min, t_max]`.
+    #[inline(always)]
+    fn boxes(&self, node: &Node, t_min: f32, t_max: f32) -> ([Vec4; 2], u32) {
+        let b = &node.bounds;
+        let (nx, ny, nz) = (self.near[0] & 1, self.near[1] & 1, self.near[2] & 1);
+        let half = |h: usize| {
+            let tnx = (b[nx][h] - self.o[0]) * self.inv[0];
+            let tfx = (b[nx ^ 1][h] - self.o[0]) * self.inv[0];
+            let tny = (b[2 + ny][h] - self.o[1]) * self.inv[1];
+            let tfy = (b[2 + (ny ^ 1)][h] - self.o[1]) * self.inv[1];
+            let tnz = (b[4 + nz][h] - self.o[2]) * self.inv[2];
+            let tfz = (b[4 + (nz ^ 1)][h] - self.o[2]) * self.inv[2];
+            let t_near = tnx.max(tny).max(tnz.max(Vec4::splat(t_min)));
+            let t_far = tfx.min(tfy).min(tfz);
+            let t_far = (t_far + t_far.abs() * SLAB_SLACK).min(Vec4::splat(t_max));
+            (t_near, t_near.cmple(t_far).bitmask())
+        };
+        let (near_lo, mask_lo) = half(0);
+        let (near_hi, mask_hi) = half(1);
+        ([near_lo, near_hi], mask_lo | (mask_hi << 4))
+    }
+
+    /// The lanes of `p` the ray hits within `[t_min, t_max]`, with their distances and
+    /// barycentrics (Möller–Trumbore, four triangles at once).
+    #[inline(always)]
+    fn triangles(&self, p: &Packet, t_min: f32, t_max: f32) -> (u32, Vec4, Vec4, Vec4) {
+        let [dx, dy, dz] = self.d;
+        let [e1x, e1y, e1z] = p.e1;
+        let [e2x, e2y, e2z] = p.e2;
+        // pvec = d x e2
+        let px = dy * e2z - dz * e2y;
+        let py = dz * e2x - dx * e2z;
+        let pz = dx * e2y - dy * e2x;
+        let det = e1x * px + e1y * py + e1z * pz;
+        let inv_det = Vec4::ONE / det;
+        // tvec = o - v0
+        let tx = self.o[0] - p.v0[0];
+        let ty = self.o[1] - p.v0[1];
+        let tz = self.o[2] - p.v0[2];
+        let b1 = (tx * px + ty * py + tz * pz) * inv_det;
+        // qvec = tvec x e1
+        let qx = ty * e1z - tz * e1y;
+        let qy = tz * e1x - tx * e1z;
+        let qz = tx * e1y - ty * e1x;
+        let b2 = (dx * qx + dy * qy + dz * qz) * inv_det;
+        let t = (e2x * qx + e2y * qy + e2z * qz) * inv_det;
+        // Comparisons with NaN are false, so a degenerate lane (det = 0) fails them.
+        let ok: BVec4A = det.cmpne(Vec4::ZERO)
+            & det.abs().cmplt(Vec4::INFINITY)
+            & b1.cmpge(Vec4::ZERO)
+            & b1.cmple(Vec4::ONE)
+            & b2.cmpge(Vec4::ZERO)
+            & (b1 + b2).cmple(Vec4::ONE)
+            & t.cmpge(Vec4::splat(t_min))
+            & t.cmple(Vec4::splat(t_max));
+        (ok.bitmask(), t, b1, b2)
+    }
+}
+
+impl WideBvh {
+    /// Builds the tree over `tris`, with two caller ids per triangle reported by its hits,
+    /// using obvhs's binary builder and the given preset.
+    pub(crate) fn build(tris: &[[Vec3A; 3]], ids: &[[u32; 2]], params: BvhBuildParams) -> WideBvh {
+        debug_assert_eq!(tris.len(), ids.len());
+        if tris.is_empty() {
+            return WideBvh {
+                nodes: Vec::new(),
+                packets: Vec::new(),
+                root: EMPTY,
+            };
+        }
+        let bvh2 = build_bvh2(tris, params);
+        let mut bvh = WideBvh {
+            nodes: Vec::new(),
+            packets: Vec::new(),
+            root: EMPTY,
+        };
+        Collapse::new(&bvh2, tris, ids).run(&mut bvh);
+        bvh
+    }
+
+    /// The closest triangle hit with `t` in `[t_min, t_max]`.
+    #[inline]
+    pub(crate) fn closest(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> Option<WideHit> {
+        CLOSEST_STACK.with(|cell| {
+            // Taken, not borrowed: a nested query (none today) would get a fresh stack.
+            let mut stack = cell.take();
+            stack.clear();
+            let found = self.closest_with(&mut stack, o, d, t_min, t_max);
+            cell.set(stack);
+            found
+        })
+    }
+
+    /// True when any triangle is hit with `t` in `[t_min, t_max]`; stops at the first found.
+    #[inline]
+    pub(crate) fn any(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> bool {
+        ANY_STACK.with(|cell| {
+            let mut stack = cell.take();
+            stack.clear();
+            let hit = self.any_with(&mut stack, o, d, t_min, t_max);
+            cell.set(stack);
+            hit
+        })
+    }
+
+    /// Front-to-back traversal: of the children a ray enters, the nearest is visited next and
+    /// the others are stacked with their entry distance, so a later hit can skip them.
+    #[inline(always)]
+    fn closest_with(
+        &self,
+        stack: &mut Vec<(u32, f32)>,
+        o: Vec3A,
+        d: Vec3A,
+        t_min: f32,
+        t_max: f32,
+    ) -> Option<WideHit> {
+        let ray = Prepared::new(o, d);
+        // The packet and lane of the best hit so far, with the hit.
+        let mut best: Option<(usize, usize, TriangleHit)> = None;
+        let mut t_best = t_max;
+        let mut current = self.root;
+        loop {
+            if current & LEAF == 0 {
+                let node = &self.nodes[current as usize];
+                let (t_near, mask) = ray.boxes(node, t_min, t_best);
+                if mask != 0 {
+                    if mask & (mask - 1) == 0 {
+                        current = node.child[mask.trailing_zeros() as usize & 7];
+                        continue;
+                    }
+                    // Two to eight children: sort them by entry distance, nearest first.
+                    let t_near = [t_near[0].to_array(), t_near[1].to_array()];
+                    let mut hits = [(0u32, 0f32); ARITY];
+                    let mut n = 0;
+                    let mut m = mask;
+                    while m != 0 {
+                        let lane = m.trailing_zeros() as usize & 7;
+                        m &= m - 1;
+                        let entry = (node.child[lane], t_near[lane >> 2][lane & 3]);
+                        let mut k = n;
+                        while k > 0 && hits[k - 1].1 > entry.1 {
+                            hits[k] = hits[k - 1];
+                            k -= 1;
+                        }
+                        hits[k] = entry;
+                        n += 1;
+                    }
+                    stack.extend(hits[1..n].iter().rev());
+                    current = hits[0].0;
+                    continue;
+                }
+            } else if current != EMPTY {
+                let index = (current & !LEAF) as usize;
+                let packet = &self.packets[index];
+                let (mask, t, b1, b2) = ray.triangles(packet, t_min, t_best);
+                if mask != 0 {
+                    let (t, b1, b2) = (t.to_array(), b1.to_array(), b2.to_array());
+                    let mut m = mask;
+                    while m != 0 {
+                        let lane = m.trailing_zeros() as usize & 3;
+                        m &= m - 1;
+                        if t[lane] <= t_best {
+                            t_best = t[lane];
+                            best = Some((
+                                index,
+                                lane,
+                                TriangleHit {
+                                    t: t[lane],
+                                    b1: b1[lane],
+                                    b2: b2[lane],
+                                },
+                            ));
+                        }
+                    }
+                }
+            }
+            // Next: the nearest stacked child not already beyond the best hit.
+            loop {
+                let Some((next, t_entry)) = stack.pop() else {
+                    return best.map(|(index, lane, tri)| self.hit_record(index, lane, tri));
+                };
+                if t_entry <= t_best {
+                    current = next;
+                    break;
+                }
+            }
+        }
+    }
+
+    #[inline(always)]
+    fn any_with(&self, stack: &mut Vec<u32>, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> bool {
+        let ray = Prepared::new(o, d);
+        let mut current = self.root;
+        loop {
+            if current & LEAF == 0 {
+                let node = &self.nodes[current as usize];
+                let (_, mut mask) = ray.boxes(node, t_min, t_max);
+                if mask != 0 {
+                    current = node.child[mask.trailing_zeros() as usize & 7];
+                    mask &= mask - 1;
+                    while mask != 0 {
+                        stack.push(node.child[mask.trailing_zeros() as usize & 7]);
+                        mask &= mask - 1;
+                    }
+                    continue;
+                }
+            } else if current != EMPTY {
+                let packet = &self.packets[(current & !LEAF) as usize];
+                if ray.triangles(packet, t_min, t_max).0 != 0 {
+                    return true;
+                }
+            }
+            let Some(next) = stack.pop() else {
+                return false;
+            };
+            current = next;
+        }
+    }
+
+    /// The full record of a hit on lane `lane` of packet `index`.
+    fn hit_record(&self, index: usize, lane: usize, tri: TriangleHit) -> WideHit {
+        let p = &self.packets[index];
+        let at = |v: &[Vec4; 3]| Vec3::new(v[0][lane], v[1][lane], v[2][lane]);
+        WideHit {
+            ids: [p.ids[0][lane], p.ids[1][lane]],
+            tri,
+            v0: at(&p.v0),
+            e1: at(&p.e1),
+            e2: at(&p.e2),
+        }
+    }
+
+    /// Bytes held by the nodes and packets (for the memory figures).
+    pub(crate) fn heap_bytes(&self) -> usize {
+        self.nodes.capacity() * size_of::<Node>() + self.packets.capacity() * size_of::<Packet>()
+    }
+}
+
+/// obvhs's binary BVH over `tris`, as its CWBVH builder makes it before collapsing.
+fn build_bvh2(tris: &[[Vec3A; 3]], params: BvhBuildParams) -> Bvh2 {
+    let input = tris
+        .iter()
+        .map(|&[v0, v1, v2]| Triangle { v0, v1, v2 })
+        .collect::<Vec<_>>();
+    let indices = (0..tris.len() as u32).collect::<Vec<_>>();
+    let mut bvh2 = if params.pre_split {
+        let mut aabbs = input.iter().map(Triangle::aabb).collect::<Vec<Aabb>>();
+        let largest = aabbs.iter().map(Aabb::half_area).fold(0.0, f32::max);
+        let average = aabbs.iter().map(Aabb::half_area).sum::<f32>() / aabbs.len() as f32;
+        let mut indices = indices;
+        split_aabbs_preset(&mut aabbs, &mut indices, &input, average, largest);
+        let mut bvh2 = PlocBuilder::with_capacity(aabbs.len()).build(
+            params.ploc_search_distance,
+            &aabbs,
+            indices,
+            params.sort_precision,
+            params.search_depth_threshold,
+        );
+        bvh2.uses_spatial_splits = true;
+        bvh2
+    } else {
+        PlocBuilder::with_capacity(input.len()).build(
+            params.ploc_search_distance,
+            &input,
+            indices,
+            params.sort_precision,
+            params.search_depth_threshold,
+        )
+    };
+    ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
+    bvh2
+}
+
+/// The collapse of a binary BVH into [`WideBvh`] nodes and packets.
+struct Collapse<'a> {
+    bvh2: &'a Bvh2,
+    tris: &'a [[Vec3A; 3]],
+    ids: &'a [[u32; 2]],
+    /// Primitive references under each binary node.
+    count: Vec<u32>,
+}
+
+impl<'a> Collapse<'a> {
+    fn new(bvh2: &'a Bvh2, tris: &'a [[Vec3A; 3]], ids: &'a [[u32; 2]]) -> Self {
+        // Children follow their parent in preorder, so a reverse preorder sweep sums leaves up.
+        let mut preorder = Vec::with_capacity(bvh2.nodes.len());
+        let mut pending = vec![0u32];
+        while let Some(i) = pending.pop() {
+            preorder.push(i);
+            let node = &bvh2.nodes[i as usize];
+            if node.prim_count == 0 {
+                pending.push(node.first_index);
+                pending.push(node.first_index + 1);
+            }
+        }
+        let mut count = vec![0u32; bvh2.nodes.len()];
+        for &i in preorder.iter().rev() {
+            let node = &bvh2.nodes[i as usize];
+            count[i as usize] = if node.prim_count == 0 {
+                count[node.first_index as usize] + count[node.first_index as usize + 1]
+            } else {
+                node.prim_count
+            };
+        }
+        Collapse {
+            bvh2,
+            tris,
+            ids,
+            count,
+        }
+    }
+
+    fn run(&self, out: &mut WideBvh) {
+        // Work list of (binary node, its wide node).
+        let mut work = Vec::new();
+        out.root = self.reference(0, out, &mut work);
+        while let Some((b2, wide)) = work.pop() {
+            let kids = self.open(b2);
+            let mut node = Node {
+                bounds: [
+                    [Vec4::INFINITY; 2],
+                    [Vec4::NEG_INFINITY; 2],
+                    [Vec4::INFINITY; 2],
+                    [Vec4::NEG_INFINITY; 2],
+                    [Vec4::INFINITY; 2],
+                    [Vec4::NEG_INFINITY; 2],
+                ],
+                child: [EMPTY; ARITY],
+            };
+            for (lane, &kid) in kids.iter().enumerate() {
+                let aabb = self.bvh2.nodes[kid as usize].aabb;
+                for axis in 0..3 {
+                    node.bounds[2 * axis][lane >> 2][lane & 3] = aabb.min[axis];
+                    node.bounds[2 * axis + 1][lane >> 2][lane & 3] = aabb.max[axis];
+                }
+            }
+            // Children are numbered before any grandchild, so siblings sit side by side.
+            let first_new = work.len();
+            for (lane, &kid) in kids.iter().enumerate() {
+                node.child[lane] = self.reference(kid, out, &mut work);
+            }
+            // Visit the first child's subtree next (depth first, for locality).
+            work[first_new..].reverse();
+            out.nodes[wide as usize] = node;
+        }
+    }
+
+    /// The reference a wide node stores for binary node `b2`: a packet for a small subtree,
+    /// else a fresh wide node queued for filling.
+    fn reference(&self, b2: u32, out: &mut WideBvh, work: &mut Vec<(u32, u32)>) -> u32 {
+        if self.count[b2 as usize] as usize <= WIDTH {
+            let packet = self.packet(b2);
+            out.packets.push(packet);
+            LEAF | (out.packets.len() as u32 - 1)
+        } else {
+            let wide = out.nodes.len() as u32;
+            out.nodes.push(Node {
+                bounds: [[Vec4::ZERO; 2]; 6],
+                child: [EMPTY; ARITY],
+            });
+            work.push((b2, wide));
+            wide
+        }
+    }
+
+    /// Up to eight binary nodes under `b2` that together cover it: the largest (by surface
+    /// area) of the nodes that will not be leaves is opened until there are eight.
+    fn open(&self, b2: u32) -> Vec<u32> {
+        let node = &self.bvh2.nodes[b2 as usize];
+        let mut kids = vec![node.first_index, node.first_index + 1];
+        while kids.len() < ARITY {
+            let widest = kids
+                .iter()
+                .enumerate()
+                .filter(|&(_, &k)| self.count[k as usize] as usize > WIDTH)
+                .max_by(|a, b| {
+                    let area = |k: u32| self.bvh2.nodes[k as usize].aabb.half_area();
+                    area(*a.1).total_cmp(&area(*b.1))
+                })
+                .map(|(i, _)| i);
+            let Some(i) = widest else { break };
+            let inner = &self.bvh2.nodes[kids[i] as usize];
+            kids[i] = inner.first_index;
+            kids.push(inner.first_index + 1);
+        }
+        kids
+    }
+
+    /// The packet of the (at most four) triangles under binary node `b2`.
+    fn packet(&self, b2: u32) -> Packet {
+        let mut packet = Packet {
+            v0: [Vec4::ZERO; 3],
+            e1: [Vec4::ZERO; 3],
+            e2: [Vec4::ZERO; 3],
+            ids: [[EMPTY; WIDTH]; 2],
+        };
+        let mut lane = 0;
+        let mut pending = vec![b2];
+        while let Some(i) = pending.pop() {
+            let node = &self.bvh2.nodes[i as usize];
+            if node.prim_count == 0 {
+                pending.push(node.first_index + 1);
+                pending.push(node.first_index);
+                continue;
+            }
+            let first = node.first_index as usize;
+            for &prim in &self.bvh2.primitive_indices[first..first + node.prim_count as usize] {
+                let [v0, v1, v2] = self.tris[prim as usize];
+                let (e1, e2) = (v1 - v0, v2 - v0);
+                for axis in 0..3 {
+                    packet.v0[axis][lane] = v0[axis];
+                    packet.e1[axis][lane] = e1[axis];
+                    packet.e2[axis][lane] = e2[axis];
+                }
+                packet.ids[0][lane] = self.ids[prim as usize][0];
+                packet.ids[1][lane] = self.ids[prim as usize][1];
+                lane += 1;
+            }
+        }
+        packet
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::intersect_triangle;
+
+    fn soup(n: usize, seed: u32) -> Vec<[Vec3A; 3]> {
+        // A small deterministic generator: the tests need no statistical quality.
+        let mut state = seed.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
+        let mut next = move || {
+            state = state.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
+            ((state >> 8) as f32 / (1u32 << 24) as f32) * 2.0 - 1.0
+        };
+        (0..n)
+            .map(|_| {
+                let c = Vec3A::new(next(), next(), next()) * 4.0;
+                [0, 1, 2].map(|_| c + Vec3A::new(next(), next(), next()) * 0.3)
+            })
+            .collect()
+    }
+
+    /// Every input triangle sits in exactly one packet lane (no pre-splits), every node's lane
+    /// box contains everything beneath it, and the stack bound covers the real depth.
+    #[test]
+    fn the_collapse_keeps_every_triangle_once_inside_its_boxes() {
+        for n in [1, 2, 4, 5, 17, 300] {
+            let tris = soup(n, n as u32);
+            let ids = (0..n as u32).map(|i| [i, i + 1000]).collect::<Vec<_>>();
+            let bvh = WideBvh::build(&tris, &ids, BvhBuildParams::medium_build());
+            let mut seen = vec![0u32; n];
+            let mut pending = vec![(bvh.root, None::<[f32; 6]>, 0usize)];
+            let mut depth_max = 0;
+            while let Some((r, bounds, depth)) = pending.pop() {
+                depth_max = depth_max.max(depth);
+                if r & LEAF == 0 {
+                    let node = &bvh.nodes[r as usize];
+                    for lane in 0..ARITY {
+                        if node.child[lane] == EMPTY {
+                            continue;
+                        }
+                        let b = node.bounds.map(|v| v[lane >> 2][lane & 3]);
+                        if let Some(outer) = bounds {
+                            for axis in 0..3 {
+                                assert!(outer[2 * axis] <= b[2 * axis]);
+                                assert!(outer[2 * axis + 1] >= b[2 * axis + 1]);
+                            }
+                        }
+                        pending.push((node.child[lane], Some(b), depth + 1));
+                    }
+                } else {
+                    let p = &bvh.packets[(r & !LEAF) as usize];
+                    for lane in 0..WIDTH {
+                        if p.ids[0][lane] == EMPTY {
+                            continue;
+                        }
+                        let prim = p.ids[0][lane] as usize;
+                        assert_eq!(p.ids[1][lane], prim as u32 + 1000);
+                        seen[prim] += 1;
+                        // A packet at the root (four triangles or fewer) has no box.
+                        let Some(b) = bounds else { continue };
+                        for corner in tris[prim] {
+                            for axis in 0..3 {
+                                assert!(b[2 * axis] <= corner[axis]);
+                                assert!(corner[axis] <= b[2 * axis + 1]);
+                            }
+                        }
+                    }
+                }
+            }
+            assert!(seen.iter().all(|&s| s == 1), "n = {n}: {seen:?}");
+            if n > WIDTH {
+                assert!(bvh.root & LEAF == 0, "more than one packet needs a node");
+            }
+        }
+    }
+
+    /// Closest and any-hit queries agree with testing every triangle, for rays from every
+    /// direction, including axis-aligned ones (zero direction components).
+    #[test]
+    fn queries_match_testing_every_triangle() {
+        let tris = soup(500, 7);
+        let ids = (0..tris.len() as u32).map(|i| [i, 7]).collect::<Vec<_>>();
+        let bvh = WideBvh::build(&tris, &ids, BvhBuildParams::fast_build());
+        let dirs = soup(200, 99);
+        for (k, d) in dirs.iter().enumerate() {
+            let o = d[0] * 3.0;
+            let mut dir = d[1] - o;
+            if k % 10 == 0 {
+                dir = Vec3A::new(0.0, 0.0, -o.z);
+            }
+            let brute = tris
+                .iter()
+                .enumerate()
+                .filter_map(|(i, t)| {
+                    intersect_triangle(o, dir, 0.0, f32::INFINITY, t).map(|h| (i as u32, h.t))
+                })
+                .min_by(|a, b| a.1.total_cmp(&b.1));
+            let got = bvh.closest(o, dir, 0.0, f32::INFINITY);
+            match (brute, got) {
+                (None, None) => {}
+                (Some((_, t_ref)), Some(h)) => {
+                    assert!(
+                        (t_ref - h.tri.t).abs() <= 1e-4 * t_ref.abs().max(1.0),
+                        "ray {k}"
+                    );
+                    // The record names the triangle hit and carries it as stored.
+                    let [v0, v1, v2] = tris[h.ids[0] as usize];
+                    assert_eq!(h.ids[1], 7);
+                    assert_eq!(Vec3A::from(h.v0), v0);
+                    assert_eq!(Vec3A::from(h.e1), v1 - v0);
+                    assert_eq!(Vec3A::from(h.e2), v2 - v0);
+                    let p = h.v0 + h.e1 * h.tri.b1 + h.e2 * h.tri.b2;
+                    let q = Vec3::from(o + dir * h.tri.t);
+                    assert!((p - q).length() <= 1e-4, "ray {k}: {p} vs {q}");
+                }
+                other => panic!("ray {k}: brute force and BVH disagree: {other:?}"),
+            }
+            assert_eq!(
+                bvh.any(o, dir, 0.0, f32::INFINITY),
+                brute.is_some(),
+                "ray {k}"
+            );
+        }
+    }
+
+    #[test]
+    fn an_empty_tree_hits_nothing() {
+        let bvh = WideBvh::build(&[], &[], BvhBuildParams::fast_build());
+        let (o, d) = (Vec3A::ZERO, Vec3A::X);
+        assert!(bvh.closest(o, d, 0.0, f32::INFINITY).is_none());
+        assert!(!bvh.any(o, d, 0.0, f32::INFINITY));
+    }
+}
