@@ -244,6 +244,7 @@ impl WideBvh {
         let ray = Prepared::new(o, d);
         // The packet and lane of the best hit so far, with the hit.
         let mut best: Option<(usize, usize, TriangleHit)> = None;
+        let mut warm = 0u32;
         let mut t_best = t_max;
         let mut current = self.root;
         loop {
@@ -272,7 +273,10 @@ impl WideBvh {
                         hits[k] = entry;
                         n += 1;
                     }
-                    stack.extend(hits[1..n].iter().rev());
+                    for &entry in hits[1..n].iter().rev() {
+                        warm ^= self.touch(entry.0);
+                        stack.push(entry);
+                    }
                     current = hits[0].0;
                     continue;
                 }
@@ -304,6 +308,7 @@ impl WideBvh {
             // Next: the nearest stacked child not already beyond the best hit.
             loop {
                 let Some((next, t_entry)) = stack.pop() else {
+                    std::hint::black_box(warm);
                     return best.map(|(index, lane, tri)| self.hit_record(index, lane, tri));
                 };
                 if t_entry <= t_best {
@@ -341,6 +346,23 @@ impl WideBvh {
                 return false;
             };
             current = next;
+        }
+    }
+
+    /// Reads one word of each cache line of a stacked child, so its lines are on their way
+    /// while the nearer child is traversed (safe Rust has no prefetch instruction; loads that
+    /// nothing waits on do the same).
+    #[inline(always)]
+    fn touch(&self, r: u32) -> u32 {
+        if r & LEAF == 0 {
+            self.nodes.get(r as usize).map_or(0, |n| {
+                let b = &n.bounds;
+                b[0][0].x.to_bits() ^ b[2][0].y.to_bits() ^ b[4][0].z.to_bits() ^ n.child[0]
+            })
+        } else {
+            self.packets.get((r & !LEAF) as usize).map_or(0, |p| {
+                p.v0[0].x.to_bits() ^ p.e1[1].y.to_bits() ^ p.e2[2].z.to_bits()
+            })
         }
     }
 
@@ -403,9 +425,17 @@ struct Collapse<'a> {
     bvh2: &'a Bvh2,
     tris: &'a [[Vec3A; 3]],
     ids: &'a [[u32; 2]],
-    /// Primitive references under each binary node.
-    count: Vec<u32>,
+    /// Per binary node `n`, the collapse's decisions. `choice[n][0]`: 0 makes `n` a packet,
+    /// `j > 0` makes it a wide node whose eight slots take `j` from its left subtree and
+    /// `8 - j` from its right. `choice[n][k - 1]` for `k >= 2`: 0 puts `n` in one slot, `j > 0`
+    /// spreads `n` over `k` slots, `j` from the left subtree and `k - j` from the right.
+    choice: Vec<[u8; ARITY]>,
 }
+
+/// Surface-area cost of visiting a wide node and of testing a packet, per unit of area
+/// (both cost about one memory round trip of three or four cache lines plus a little SIMD).
+const COST_NODE: f32 = 1.0;
+const COST_PACKET: f32 = 1.0;
 
 impl<'a> Collapse<'a> {
     fn new(bvh2: &'a Bvh2, tris: &'a [[Vec3A; 3]], ids: &'a [[u32; 2]]) -> Self {
@@ -429,11 +459,87 @@ impl<'a> Collapse<'a> {
                 node.prim_count
             };
         }
+        let choice = Self::plan(bvh2, &preorder, &count);
         Collapse {
             bvh2,
             tris,
             ids,
-            count,
+            choice,
+        }
+    }
+
+    /// The optimal collapse under the surface area heuristic, by dynamic programming over the
+    /// binary tree (after Ylitie et al. 2017, with four-triangle packets as leaves):
+    /// `cost[n][k - 1]` is the least cost of covering `n`'s subtree with at most `k` slots of
+    /// its parent, each slot a packet (subtrees of at most four triangles) or a wide node.
+    fn plan(bvh2: &Bvh2, preorder: &[u32], count: &[u32]) -> Vec<[u8; ARITY]> {
+        let mut cost = vec![[0f32; ARITY]; bvh2.nodes.len()];
+        let mut choice = vec![[0u8; ARITY]; bvh2.nodes.len()];
+        for &i in preorder.iter().rev() {
+            let i = i as usize;
+            let node = &bvh2.nodes[i];
+            let area = node.aabb.half_area();
+            let as_packet = if count[i] as usize <= WIDTH {
+                area * COST_PACKET
+            } else {
+                f32::INFINITY
+            };
+            if node.prim_count != 0 {
+                // A binary leaf is never opened: PLOC makes one per triangle, so it always
+                // fits a packet.
+                assert!(
+                    node.prim_count as usize <= WIDTH,
+                    "obvhs's PLOC leaves hold one primitive"
+                );
+                cost[i] = [as_packet; ARITY];
+                continue;
+            }
+            let (l, r) = (node.first_index as usize, node.first_index as usize + 1);
+            // The best way to spread the two subtrees over k slots, k = 2..=8.
+            let mut split = [f32::INFINITY; ARITY];
+            let mut at = [0u8; ARITY];
+            for k in 2..=ARITY {
+                for j in 1..k {
+                    let c = cost[l][j - 1] + cost[r][k - j - 1];
+                    if c < split[k - 1] {
+                        split[k - 1] = c;
+                        at[k - 1] = j as u8;
+                    }
+                }
+            }
+            let as_node = area * COST_NODE + split[ARITY - 1];
+            let single = as_packet.min(as_node);
+            cost[i][0] = single;
+            choice[i][0] = if as_packet <= as_node {
+                0
+            } else {
+                at[ARITY - 1]
+            };
+            for k in 2..=ARITY {
+                if split[k - 1] < single {
+                    cost[i][k - 1] = split[k - 1];
+                    choice[i][k - 1] = at[k - 1];
+                } else {
+                    cost[i][k - 1] = single;
+                }
+            }
+        }
+        choice
+    }
+
+    /// The binary nodes that fill `k` slots for `n`'s subtree, in tree order.
+    fn slots(&self, n: u32, k: usize, out: &mut Vec<u32>) {
+        let j = if k >= 2 {
+            self.choice[n as usize][k - 1]
+        } else {
+            0
+        };
+        if j == 0 {
+            out.push(n);
+        } else {
+            let first = self.bvh2.nodes[n as usize].first_index;
+            self.slots(first, usize::from(j), out);
+            self.slots(first + 1, k - usize::from(j), out);
         }
     }
 
@@ -475,7 +581,7 @@ impl<'a> Collapse<'a> {
     /// The reference a wide node stores for binary node `b2`: a packet for a small subtree,
     /// else a fresh wide node queued for filling.
     fn reference(&self, b2: u32, out: &mut WideBvh, work: &mut Vec<(u32, u32)>) -> u32 {
-        if self.count[b2 as usize] as usize <= WIDTH {
+        if self.choice[b2 as usize][0] == 0 {
             let packet = self.packet(b2);
             out.packets.push(packet);
             LEAF | (out.packets.len() as u32 - 1)
@@ -490,26 +596,13 @@ impl<'a> Collapse<'a> {
         }
     }
 
-    /// Up to eight binary nodes under `b2` that together cover it: the largest (by surface
-    /// area) of the nodes that will not be leaves is opened until there are eight.
+    /// The binary nodes that become the children of `b2`'s wide node.
     fn open(&self, b2: u32) -> Vec<u32> {
-        let node = &self.bvh2.nodes[b2 as usize];
-        let mut kids = vec![node.first_index, node.first_index + 1];
-        while kids.len() < ARITY {
-            let widest = kids
-                .iter()
-                .enumerate()
-                .filter(|&(_, &k)| self.count[k as usize] as usize > WIDTH)
-                .max_by(|a, b| {
-                    let area = |k: u32| self.bvh2.nodes[k as usize].aabb.half_area();
-                    area(*a.1).total_cmp(&area(*b.1))
-                })
-                .map(|(i, _)| i);
-            let Some(i) = widest else { break };
-            let inner = &self.bvh2.nodes[kids[i] as usize];
-            kids[i] = inner.first_index;
-            kids.push(inner.first_index + 1);
-        }
+        let j = usize::from(self.choice[b2 as usize][0]);
+        let first = self.bvh2.nodes[b2 as usize].first_index;
+        let mut kids = Vec::with_capacity(ARITY);
+        self.slots(first, j, &mut kids);
+        self.slots(first + 1, ARITY - j, &mut kids);
         kids
     }
 
