@@ -322,6 +322,7 @@ impl WideBvh {
     #[inline(always)]
     fn any_with(&self, stack: &mut Vec<u32>, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> bool {
         let ray = Prepared::new(o, d);
+        let mut warm = 0u32;
         let mut current = self.root;
         loop {
             if current & LEAF == 0 {
@@ -331,7 +332,9 @@ impl WideBvh {
                     current = node.child[mask.trailing_zeros() as usize & 7];
                     mask &= mask - 1;
                     while mask != 0 {
-                        stack.push(node.child[mask.trailing_zeros() as usize & 7]);
+                        let child = node.child[mask.trailing_zeros() as usize & 7];
+                        warm ^= self.touch(child);
+                        stack.push(child);
                         mask &= mask - 1;
                     }
                     continue;
@@ -339,10 +342,12 @@ impl WideBvh {
             } else if current != EMPTY {
                 let packet = &self.packets[(current & !LEAF) as usize];
                 if ray.triangles(packet, t_min, t_max).0 != 0 {
+                    std::hint::black_box(warm);
                     return true;
                 }
             }
             let Some(next) = stack.pop() else {
+                std::hint::black_box(warm);
                 return false;
             };
             current = next;
