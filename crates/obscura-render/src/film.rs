@@ -10,6 +10,7 @@
 
 use crate::scene::FilterSettings;
 use glam::{Vec2, Vec3};
+use rayon::prelude::*;
 
 /// A separable reconstruction filter `f(dx) f(dy)`, with `dx`, `dy` in pixels from the pixel's
 /// centre.
@@ -251,6 +252,23 @@ impl Film {
                 self.sums[dst].add(src);
             }
         }
+    }
+
+    /// Adds `other`'s sums pixel by pixel (films of the same bounds). Each pixel gets one
+    /// addition, so the result does not depend on how the work is split between threads.
+    pub fn add(&mut self, other: &Film) {
+        debug_assert_eq!(self.bounds, other.bounds);
+        self.sums
+            .par_chunks_mut(4096)
+            .zip(other.sums.par_chunks(4096))
+            .for_each(|(a, b)| a.iter_mut().zip(b).for_each(|(a, b)| a.add(b)));
+    }
+
+    /// Sets every sum back to zero.
+    pub fn clear(&mut self) {
+        self.sums
+            .par_chunks_mut(4096)
+            .for_each(|a| a.fill(PixelSums::default()));
     }
 
     /// The image: RGBA per pixel, row 0 at the top.

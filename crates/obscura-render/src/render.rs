@@ -1,8 +1,9 @@
 //! The parallel tile renderer: passes of one sample per pixel over tiles, merged in order.
 //!
 //! A render is a sequence of passes; pass `k` takes sample index `k` of every pixel. Within a
-//! pass, tiles are rendered in parallel (rayon) into their own buffers, and merged into the
-//! film in tile order. The pass schedule depends only on the scene, never on threads or timing,
+//! pass, tiles are rendered in parallel (rayon) into their own buffers, merged in tile order
+//! into a pass accumulator (one batch of tiles merging while the next renders), and the pass is
+//! then added to the film pixel by pixel. The pass schedule depends only on the scene, never on threads or timing,
 //! so a render is bit-identical for any thread count, and a render stopped after pass `k` and
 //! resumed from there equals one that ran straight through.
 
@@ -22,7 +23,7 @@ use std::time::{Duration, Instant};
 pub const TILE_SIZE: u32 = 16;
 
 /// How many tiles are rendered before they are merged (bounds the memory of tile buffers).
-const TILES_PER_BATCH: usize = 64;
+const TILES_PER_BATCH: usize = 256;
 
 /// Counters of a render.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -120,35 +121,52 @@ pub fn render(
     let path = PathIntegrator::new(scene.description.integrator.max_depth);
 
     pool.install(|| {
+        // One pass's samples are summed here, then added to the film pixel by pixel, so a
+        // pass cut short leaves the film untouched and no per-pass copy of it is needed.
+        let mut pass_film = Film::new(scene.pixel_bounds);
         'passes: for pass in first_pass..spp {
-            let mut pass_film = film.clone();
+            pass_film.clear();
+            // Tile buffers rendered but not yet merged: a batch is merged (in tile order, on
+            // one thread) while the next batch renders on the others.
+            let mut pending: Vec<TileBuffer> = Vec::new();
             for batch in tiles.chunks(TILES_PER_BATCH) {
-                let buffers: Vec<Option<TileBuffer>> = batch
-                    .par_iter()
-                    .map(|&tile| {
-                        if cancelled() {
-                            return None;
+                let (buffers, ()) = rayon::join(
+                    || {
+                        batch
+                            .par_iter()
+                            .map(|&tile| {
+                                if cancelled() {
+                                    return None;
+                                }
+                                let mut buffer =
+                                    TileBuffer::new(tile, scene.pixel_bounds, scene.filter);
+                                let counts = render_tile(scene, &path, tile, pass, &mut buffer);
+                                samples.fetch_add(counts.samples, Ordering::Relaxed);
+                                dropped.fetch_add(counts.dropped_nonfinite, Ordering::Relaxed);
+                                no_ray.fetch_add(counts.no_ray, Ordering::Relaxed);
+                                let done = tiles_done.fetch_add(1, Ordering::Relaxed) + 1;
+                                if let Some(f) = options.on_tile {
+                                    f(done, total_tiles);
+                                }
+                                Some(buffer)
+                            })
+                            .collect::<Vec<Option<TileBuffer>>>()
+                    },
+                    || {
+                        for b in pending.drain(..) {
+                            pass_film.merge(&b);
                         }
-                        let mut buffer = TileBuffer::new(tile, scene.pixel_bounds, scene.filter);
-                        let counts = render_tile(scene, &path, tile, pass, &mut buffer);
-                        samples.fetch_add(counts.samples, Ordering::Relaxed);
-                        dropped.fetch_add(counts.dropped_nonfinite, Ordering::Relaxed);
-                        no_ray.fetch_add(counts.no_ray, Ordering::Relaxed);
-                        let done = tiles_done.fetch_add(1, Ordering::Relaxed) + 1;
-                        if let Some(f) = options.on_tile {
-                            f(done, total_tiles);
-                        }
-                        Some(buffer)
-                    })
-                    .collect();
+                    },
+                );
                 if buffers.iter().any(Option::is_none) {
                     break 'passes;
                 }
-                for b in buffers.iter().flatten() {
-                    pass_film.merge(b);
-                }
+                pending = buffers.into_iter().flatten().collect();
             }
-            film = pass_film;
+            for b in &pending {
+                pass_film.merge(b);
+            }
+            film.add(&pass_film);
             passes_done = pass + 1;
             if let Some(f) = options.on_pass {
                 f(passes_done, spp, &film);
