@@ -188,13 +188,29 @@ impl TileBuffer {
             return;
         }
         let (l, coverage) = (l.as_dvec3(), if hit { 1.0 } else { 0.0 });
+        // The column weights are the same for every row: evaluate them once (for footprints
+        // up to COLUMNS wide, which covers every filter at its default radius).
+        const COLUMNS: usize = 8;
+        let (x0, x1) = (lo.x as u32, hi.x as u32);
+        let mut wx = [0f32; COLUMNS];
+        let cached = ((x1 - x0) as usize) < COLUMNS;
+        if cached {
+            for (k, w) in wx.iter_mut().enumerate().take((x1 - x0) as usize + 1) {
+                *w = self.filter.eval_1d(p.x - ((x0 + k as u32) as f32 + 0.5));
+            }
+        }
         for y in lo.y as u32..=hi.y as u32 {
             let wy = self.filter.eval_1d(p.y - (y as f32 + 0.5));
             if wy == 0.0 {
                 continue;
             }
-            for x in lo.x as u32..=hi.x as u32 {
-                let w = f64::from(wy * self.filter.eval_1d(p.x - (x as f32 + 0.5)));
+            for x in x0..=x1 {
+                let w_col = if cached {
+                    wx[(x - x0) as usize]
+                } else {
+                    self.filter.eval_1d(p.x - (x as f32 + 0.5))
+                };
+                let w = f64::from(wy * w_col);
                 if w == 0.0 {
                     continue;
                 }
