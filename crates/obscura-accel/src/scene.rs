@@ -8,7 +8,7 @@ use crate::geom::{
 };
 use crate::hit::Hit;
 use crate::mesh::TriangleMesh;
-use crate::wide::{WideBvh, WideHit};
+use crate::wide::{BoxSet, WideBvh, WideHit};
 use glam::{Vec2, Vec3, Vec3A};
 use obscura_space::{
     AnimatedTransform, Bounds3, Normal3, Object, Point3, Ray, Transform, Vector3, World,
@@ -319,29 +319,32 @@ impl SceneBuilder {
         }
         let bounds = item_bounds.iter().fold(Bounds3::EMPTY, |a, b| a.union(*b));
 
-        // The top level: skipped when there is a single item (one mesh, the common benchmark).
-        let tlas = if items.len() > 1 {
-            let aabbs = item_bounds
-                .iter()
-                .map(|b| {
-                    // Pad flat boxes (a quad in an axis plane) by a relative hair.
-                    let d = b.diagonal().to_glam().abs().max_element();
-                    let pad = Vec3A::splat(d * 1e-6 + f32::MIN_POSITIVE);
-                    Aabb::new(
-                        Vec3A::from(b.min.to_glam()) - pad,
-                        Vec3A::from(b.max.to_glam()) + pad,
-                    )
-                })
-                .collect::<Vec<_>>();
+        // The top level: none for a single item (one mesh, the common benchmark), one SIMD
+        // test of up to eight boxes for a few, obvhs's tree for more.
+        let aabbs = item_bounds
+            .iter()
+            .map(|b| {
+                // Pad flat boxes (a quad in an axis plane) by a relative hair.
+                let d = b.diagonal().to_glam().abs().max_element();
+                let pad = Vec3A::splat(d * 1e-6 + f32::MIN_POSITIVE);
+                Aabb::new(
+                    Vec3A::from(b.min.to_glam()) - pad,
+                    Vec3A::from(b.max.to_glam()) + pad,
+                )
+            })
+            .collect::<Vec<_>>();
+        let tlas = if items.len() <= 1 {
+            Top::One
+        } else if let Some(set) = BoxSet::new(&aabbs) {
+            Top::Few(set)
+        } else {
             let bvh = build_cwbvh(
                 &aabbs,
                 BvhBuildParams::fast_build(),
                 &mut Duration::default(),
             );
             let order = bvh.primitive_indices.clone();
-            Some((bvh, order))
-        } else {
-            None
+            Top::Tree(bvh, order)
         };
 
         Ok(Scene {
@@ -360,8 +363,8 @@ impl SceneBuilder {
 #[derive(Debug)]
 pub struct Scene {
     items: Vec<Item>,
-    /// The top-level BVH and its slot -> item map; `None` for zero or one item.
-    tlas: Option<(CwBvh, Vec<u32>)>,
+    /// How rays find the items.
+    tlas: Top,
     /// All static mesh triangles in world space; hits carry (triangle, instance).
     flat: Option<WideBvh>,
     /// One object-space BVH per distinct moving mesh.
@@ -369,6 +372,17 @@ pub struct Scene {
     meshes: Vec<Option<Arc<TriangleMesh>>>,
     statics: Vec<Option<Transform<World, Object>>>,
     bounds: Bounds3<World>,
+}
+
+/// The top level of a [`Scene`].
+#[derive(Debug)]
+enum Top {
+    /// Zero or one item: no top level.
+    One,
+    /// A few items, their boxes tested at once.
+    Few(BoxSet),
+    /// obvhs's tree over the items, with its slot -> item map.
+    Tree(CwBvh, Vec<u32>),
 }
 
 #[derive(Debug, Clone)]
@@ -492,9 +506,24 @@ impl Scene {
     pub fn intersect(&self, ray: &Ray<World>) -> Option<Hit> {
         let r = PlainRay::new(ray)?;
         let found = match &self.tlas {
-            None if self.items.len() == 1 => self.intersect_item(0, &r, r.t_max),
-            None => None,
-            Some((tlas, order)) => {
+            Top::One if self.items.len() == 1 => self.intersect_item(0, &r, r.t_max),
+            Top::One => None,
+            Top::Few(set) => {
+                let mut entered = [(0, 0.0); BoxSet::CAPACITY];
+                let n = set.entered(r.o, r.d, r.t_min, r.t_max, &mut entered);
+                let mut best: Option<Found> = None;
+                for &(item, t_entry) in &entered[..n] {
+                    let t_max = best.map_or(r.t_max, |f| f.t());
+                    if t_entry > t_max {
+                        break;
+                    }
+                    if let Some(f) = self.intersect_item(item, &r, t_max) {
+                        best = Some(f);
+                    }
+                }
+                best
+            }
+            Top::Tree(tlas, order) => {
                 let top = obvhs::ray::Ray::new(r.o, r.d, r.t_min, r.t_max);
                 let mut ray_hit = RayHit::none();
                 let mut best = None;
@@ -520,9 +549,16 @@ impl Scene {
             return false;
         };
         match &self.tlas {
-            None if self.items.len() == 1 => self.occluded_item(0, &r),
-            None => false,
-            Some((tlas, order)) => {
+            Top::One if self.items.len() == 1 => self.occluded_item(0, &r),
+            Top::One => false,
+            Top::Few(set) => {
+                let mut entered = [(0, 0.0); BoxSet::CAPACITY];
+                let n = set.entered(r.o, r.d, r.t_min, r.t_max, &mut entered);
+                entered[..n]
+                    .iter()
+                    .any(|&(item, _)| self.occluded_item(item, &r))
+            }
+            Top::Tree(tlas, order) => {
                 let top = obvhs::ray::Ray::new(r.o, r.d, r.t_min, r.t_max);
                 !tlas.ray_traverse_miss(top, |_, slot| {
                     if self.occluded_item(order[slot] as usize, &r) {

@@ -390,6 +390,78 @@ impl WideBvh {
     }
 }
 
+/// Up to eight boxes tested together: the top level of a scene with few instances, where a
+/// tree over them would cost more than one wide node test.
+#[derive(Clone, Debug)]
+pub(crate) struct BoxSet {
+    node: Node,
+    len: usize,
+}
+
+impl BoxSet {
+    /// The most boxes a set holds.
+    pub(crate) const CAPACITY: usize = ARITY;
+
+    /// A set of `boxes` (at most [`BoxSet::CAPACITY`]); `None` when there are more.
+    pub(crate) fn new(boxes: &[Aabb]) -> Option<BoxSet> {
+        if boxes.len() > ARITY {
+            return None;
+        }
+        let mut node = Node {
+            bounds: [
+                [Vec4::INFINITY; 2],
+                [Vec4::NEG_INFINITY; 2],
+                [Vec4::INFINITY; 2],
+                [Vec4::NEG_INFINITY; 2],
+                [Vec4::INFINITY; 2],
+                [Vec4::NEG_INFINITY; 2],
+            ],
+            child: [EMPTY; ARITY],
+        };
+        for (lane, aabb) in boxes.iter().enumerate() {
+            node.child[lane] = lane as u32;
+            for axis in 0..3 {
+                node.bounds[2 * axis][lane >> 2][lane & 3] = aabb.min[axis];
+                node.bounds[2 * axis + 1][lane >> 2][lane & 3] = aabb.max[axis];
+            }
+        }
+        Some(BoxSet {
+            node,
+            len: boxes.len(),
+        })
+    }
+
+    /// The boxes the ray enters within `[t_min, t_max]`, as (index, entry distance), nearest
+    /// first, in `out`.
+    #[inline]
+    pub(crate) fn entered(
+        &self,
+        o: Vec3A,
+        d: Vec3A,
+        t_min: f32,
+        t_max: f32,
+        out: &mut [(usize, f32); ARITY],
+    ) -> usize {
+        let (t_near, mask) = Prepared::new(o, d).boxes(&self.node, t_min, t_max);
+        let t_near = [t_near[0].to_array(), t_near[1].to_array()];
+        let mut n = 0;
+        let mut m = mask & ((1u32 << self.len) - 1);
+        while m != 0 {
+            let lane = m.trailing_zeros() as usize & 7;
+            m &= m - 1;
+            let entry = (lane, t_near[lane >> 2][lane & 3]);
+            let mut k = n;
+            while k > 0 && out[k - 1].1 > entry.1 {
+                out[k] = out[k - 1];
+                k -= 1;
+            }
+            out[k] = entry;
+            n += 1;
+        }
+        n
+    }
+}
+
 /// obvhs's binary BVH over `tris`, as its CWBVH builder makes it before collapsing.
 fn build_bvh2(tris: &[[Vec3A; 3]], params: BvhBuildParams) -> Bvh2 {
     let input = tris
