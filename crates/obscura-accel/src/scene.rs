@@ -216,6 +216,7 @@ impl SceneBuilder {
                 p => p,
             };
             let xform = match &placement {
+                Placement::Static(t) if t.is_identity() => Xform::Identity,
                 Placement::Static(t) => Xform::Static(*t),
                 Placement::Moving(a) => Xform::Moving(a.clone()),
             };
@@ -387,6 +388,8 @@ enum Top {
 
 #[derive(Debug, Clone)]
 enum Xform {
+    /// Object space is world space: rays need no transform.
+    Identity,
     Static(Transform<World, Object>),
     Moving(AnimatedTransform<World, Object>),
 }
@@ -395,12 +398,23 @@ impl Xform {
     #[inline]
     fn at(&self, time: f32) -> Transform<World, Object> {
         match self {
+            Xform::Identity => Transform::IDENTITY,
             Xform::Static(t) => *t,
             Xform::Moving(a) => a.at(time),
         }
     }
+    /// The ray's origin and direction in object space at the ray's time.
+    #[inline]
+    fn ray_to_object(&self, r: &PlainRay) -> (Vec3A, Vec3A) {
+        match self {
+            Xform::Identity => (r.o, r.d),
+            _ => to_object(&self.at(r.time).inverse(), r),
+        }
+    }
+
     fn bounds(&self, b: Bounds3<Object>) -> Bounds3<World> {
         match self {
+            Xform::Identity => Transform::IDENTITY.bounds(b),
             Xform::Static(t) => t.bounds(b),
             Xform::Moving(a) => a.motion_bounds(b),
         }
@@ -607,8 +621,7 @@ impl Scene {
                 Some(Found::Moving { item, hit })
             }
             Item::Analytic { shape, xform, .. } => {
-                let object_from_world = xform.at(r.time).inverse();
-                let (o, d) = to_object(&object_from_world, r);
+                let (o, d) = xform.ray_to_object(r);
                 let (o, d) = (Vec3::from(o), Vec3::from(d));
                 match *shape {
                     Analytic::Sphere { center, radius } => {
@@ -719,7 +732,11 @@ impl Scene {
                 let Analytic::Sphere { center, radius } = shape else {
                     unreachable!("Found::Sphere comes from a sphere")
                 };
-                let (o, d) = to_object(&world_from_object.inverse(), r);
+                let (o, d) = if world_from_object.is_identity() {
+                    (r.o, r.d)
+                } else {
+                    to_object(&world_from_object.inverse(), r)
+                };
                 let p_hit = Vec3::from(o + d * t);
                 // Reproject onto the surface: the error is then that of the projection.
                 let mut rel = p_hit - center;
@@ -803,15 +820,20 @@ impl Scene {
         instance: u32,
         world_from_object: &Transform<World, Object>,
     ) -> Hit {
-        let (p, p_error) =
-            transform_point_with_error(&world_from_object.matrix(), p_object, err_object);
-        let p_error = p_error
-            + object_space_error(
-                &world_from_object.matrix(),
-                &world_from_object.inverse_matrix(),
-                p,
-            );
-        let n = Normal3::from_glam(normal_to_world(world_from_object, n_object));
+        let (p, p_error, n) = if world_from_object.is_identity() {
+            (p_object, err_object, n_object.normalize())
+        } else {
+            let (p, p_error) =
+                transform_point_with_error(&world_from_object.matrix(), p_object, err_object);
+            let p_error = p_error
+                + object_space_error(
+                    &world_from_object.matrix(),
+                    &world_from_object.inverse_matrix(),
+                    p,
+                );
+            (p, p_error, normal_to_world(world_from_object, n_object))
+        };
+        let n = Normal3::from_glam(n);
         Hit {
             t,
             p: Point3::from_glam(p),
