@@ -92,7 +92,14 @@ pub(crate) fn permute(i: u32, n: u32, key: u64) -> u32 {
 /// shuffled without losing the net properties of the first `2^m` points.
 #[inline]
 pub(crate) fn owen_scramble(v: u32, seed: u32) -> u32 {
-    let mut x = v.reverse_bits();
+    owen_hash(v.reverse_bits(), seed).reverse_bits()
+}
+
+/// The body of [`owen_scramble`], on the bit-reversed value and giving the bit-reversed result:
+/// `owen_scramble(v, s) == owen_hash(v.reverse_bits(), s).reverse_bits()`. Callers that hold a
+/// value already reversed save the two reversals (a dozen instructions each on x86-64).
+#[inline]
+pub(crate) fn owen_hash(mut x: u32, seed: u32) -> u32 {
     x = x.wrapping_add(seed);
     x ^= x.wrapping_mul(0x5a3e_16c4);
     x = x.wrapping_mul((seed >> 15) | 1);
@@ -100,7 +107,7 @@ pub(crate) fn owen_scramble(v: u32, seed: u32) -> u32 {
     x = x.wrapping_add(seed.rotate_left(13));
     x ^= x.wrapping_mul(0xa7c2_4b1a);
     x ^= x.wrapping_mul(0x36f0_9d54);
-    x.reverse_bits()
+    x
 }
 
 /// A value in `[0, 1)` that lies in stratum `stratum` of `count` equal strata: in

@@ -140,10 +140,20 @@ impl Sampler {
     /// simply continue.
     #[inline]
     pub fn value(&self, pixel: [u32; 2], index: u32, dimension: u32) -> f32 {
-        self.value_keyed(pixel_key(self.seed, pixel), index, dimension)
+        self.value_keyed(self.key(pixel), index, dimension)
     }
 
-    /// [`Sampler::value`] with the pixel's key already hashed.
+    /// The per-pixel key the `*_keyed` functions take (Sobol's is tagged once here).
+    #[inline]
+    fn key(&self, pixel: [u32; 2]) -> u64 {
+        let key = pixel_key(self.seed, pixel);
+        match self.kind {
+            SamplerKind::Sobol => sequences::sobol_key(key),
+            _ => key,
+        }
+    }
+
+    /// [`Sampler::value`] with the pixel's key from [`Sampler::key`].
     #[inline]
     fn value_keyed(&self, pixel_key: u64, index: u32, dimension: u32) -> f32 {
         match self.kind {
@@ -182,7 +192,7 @@ impl Sampler {
     pub fn stream(&self, pixel: [u32; 2], index: u32) -> SampleStream<'_> {
         SampleStream {
             sampler: self,
-            pixel_key: pixel_key(self.seed, pixel),
+            pixel_key: self.key(pixel),
             index,
             dimension: 0,
         }

@@ -7,7 +7,8 @@ use rand_core::Rng;
 use rand_pcg::Pcg32;
 
 use crate::hash::{
-    combine, in_stratum, mix64, owen_scramble, permute, unit_f32_from_bits, unit_f64_from_bits,
+    combine, in_stratum, mix64, owen_hash, owen_scramble, permute, unit_f32_from_bits,
+    unit_f64_from_bits,
 };
 
 /// Tags that keep the hash streams of the samplers and of their parts apart.
@@ -165,29 +166,37 @@ pub(crate) fn halton(pixel_key: u64, index: u32, dimension: u32) -> f32 {
 /// The second dimension of the Sobol sequence as a 32-bit binary fraction: its generator
 /// matrix is Pascal's triangle modulo 2, whose successive columns `v` are obtained by
 /// `v ^= v >> 1` from `v = 1 << 31`.
-///
-/// The product is linear over XOR, so it is read from four tables of 256 entries, one per byte
-/// of the index: the index is Owen-shuffled before it gets here, so it has all 32 bits set at
-/// random, and the bit-by-bit loop ([`sobol_second_bitwise`], the reference) mispredicted a
-/// branch per bit; the sampler was a third of a path-traced render's time.
-#[inline]
+#[cfg(test)]
 pub(crate) fn sobol_second(index: u32) -> u32 {
-    let [b0, b1, b2, b3] = index.to_le_bytes();
-    SOBOL_SECOND_BYTES[0][b0 as usize]
-        ^ SOBOL_SECOND_BYTES[1][b1 as usize]
-        ^ SOBOL_SECOND_BYTES[2][b2 as usize]
-        ^ SOBOL_SECOND_BYTES[3][b3 as usize]
+    sobol_second_reversed(index).reverse_bits()
 }
 
-/// `SOBOL_SECOND_BYTES[k][b]` is the product of the generator matrix with byte `b` placed at
-/// bits `8k..8k + 8` of the index, computed at compile time by the bitwise reference.
-static SOBOL_SECOND_BYTES: [[u32; 256]; 4] = {
+/// [`sobol_second_bitwise`]`(index).reverse_bits()`: the second Sobol dimension with its bits
+/// reversed, as the Owen scramble consumes it.
+///
+/// The product is linear over XOR (and bit reversal distributes over XOR), so it is read from
+/// four tables of 256 entries, one per byte of the index: the index is Owen-shuffled before it
+/// gets here, so it has all 32 bits set at random, and the bit-by-bit loop (the reference)
+/// mispredicted a branch per bit; the sampler was a third of a path-traced render's time.
+#[inline]
+pub(crate) fn sobol_second_reversed(index: u32) -> u32 {
+    let [b0, b1, b2, b3] = index.to_le_bytes();
+    SOBOL_SECOND_BYTES_REVERSED[0][b0 as usize]
+        ^ SOBOL_SECOND_BYTES_REVERSED[1][b1 as usize]
+        ^ SOBOL_SECOND_BYTES_REVERSED[2][b2 as usize]
+        ^ SOBOL_SECOND_BYTES_REVERSED[3][b3 as usize]
+}
+
+/// `SOBOL_SECOND_BYTES_REVERSED[k][b]` is the product of the generator matrix with byte `b`
+/// placed at bits `8k..8k + 8` of the index, bit-reversed, computed at compile time by the
+/// bitwise reference.
+static SOBOL_SECOND_BYTES_REVERSED: [[u32; 256]; 4] = {
     let mut table = [[0u32; 256]; 4];
     let mut k = 0;
     while k < 4 {
         let mut b = 0;
         while b < 256 {
-            table[k][b] = sobol_second_bitwise((b as u32) << (8 * k));
+            table[k][b] = sobol_second_bitwise((b as u32) << (8 * k)).reverse_bits();
             b += 1;
         }
         k += 1;
@@ -195,7 +204,8 @@ static SOBOL_SECOND_BYTES: [[u32; 256]; 4] = {
     table
 };
 
-/// [`sobol_second`] one index bit at a time: the definition the tables are built from.
+/// The second Sobol dimension one index bit at a time: the definition the tables are built
+/// from.
 pub(crate) const fn sobol_second_bitwise(mut index: u32) -> u32 {
     let mut result = 0u32;
     let mut column = 1u32 << 31;
@@ -217,19 +227,27 @@ pub(crate) const fn sobol_second_bitwise(mut index: u32) -> u32 {
 /// indices `0..2^m` onto an aligned block of `2^m` indices: those are again a (0,m,2)-net, and
 /// Owen scrambling keeps nets, so every pair of dimensions of the first `2^m` samples puts
 /// exactly one point in each elementary interval of area `2^-m`.
+///
+/// `key` is the pixel's key tagged for Sobol by [`sobol_key`] (once per pixel, not per value).
 #[inline]
-pub(crate) fn sobol(pixel_key: u64, index: u32, dimension: u32) -> f32 {
-    let pair_key = sobol_pair_key(pixel_key, dimension / 2);
+pub(crate) fn sobol(key: u64, index: u32, dimension: u32) -> f32 {
+    let pair_key = combine(key, u64::from(dimension / 2));
     let shuffled = owen_scramble(index, pair_key as u32);
     sobol_coordinate(pair_key, shuffled, dimension % 2)
+}
+
+/// The key [`sobol`] and [`sobol_pair`] take: the pixel's key tagged for this sampler.
+#[inline]
+pub(crate) fn sobol_key(pixel_key: u64) -> u64 {
+    combine(pixel_key, TAG_SOBOL)
 }
 
 /// Both coordinates of pair `pair` (dimensions `2 pair` and `2 pair + 1`): the same values as
 /// two [`sobol`] calls, with the pair's key and index shuffle computed once (the sampler is a
 /// third of a path-traced render's time, mostly hashing).
 #[inline]
-pub(crate) fn sobol_pair(pixel_key: u64, index: u32, pair: u32) -> [f32; 2] {
-    let pair_key = sobol_pair_key(pixel_key, pair);
+pub(crate) fn sobol_pair(key: u64, index: u32, pair: u32) -> [f32; 2] {
+    let pair_key = combine(key, u64::from(pair));
     let shuffled = owen_scramble(index, pair_key as u32);
     [
         sobol_coordinate(pair_key, shuffled, 0),
@@ -237,22 +255,22 @@ pub(crate) fn sobol_pair(pixel_key: u64, index: u32, pair: u32) -> [f32; 2] {
     ]
 }
 
-#[inline]
-fn sobol_pair_key(pixel_key: u64, pair: u32) -> u64 {
-    combine(combine(pixel_key, TAG_SOBOL), u64::from(pair))
-}
-
 /// Coordinate `which` (0 or 1) of the pair's (0,2)-sequence point at the shuffled index,
 /// Owen-scrambled.
+///
+/// The raw coordinates are the van der Corput radical inverse (the index's bits reversed) and
+/// the second Sobol dimension; the scramble works on reversed bits, so both are formed
+/// reversed (the index itself, and [`sobol_second_reversed`]) and [`owen_hash`] reverses once:
+/// the same value as `owen_scramble(raw, seed)` with two bit reversals fewer.
 #[inline]
 fn sobol_coordinate(pair_key: u64, shuffled: u32, which: u32) -> f32 {
-    let raw = if which == 0 {
-        shuffled.reverse_bits()
+    let raw_reversed = if which == 0 {
+        shuffled
     } else {
-        sobol_second(shuffled)
+        sobol_second_reversed(shuffled)
     };
     let scramble_seed = combine(pair_key, u64::from(which) + 1) as u32;
-    unit_f32_from_bits(owen_scramble(raw, scramble_seed))
+    unit_f32_from_bits(owen_hash(raw_reversed, scramble_seed).reverse_bits())
 }
 
 #[cfg(test)]
@@ -288,6 +306,10 @@ mod tests {
         for _ in 0..100_000 {
             i = i.wrapping_mul(0x9e37_79b9).wrapping_add(0x7f4a_7c15);
             assert_eq!(sobol_second(i), sobol_second_bitwise(i), "index {i:#x}");
+            assert_eq!(
+                sobol_second_reversed(i),
+                sobol_second_bitwise(i).reverse_bits()
+            );
         }
     }
 
