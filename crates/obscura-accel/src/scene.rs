@@ -566,11 +566,16 @@ impl Scene {
             Top::One if self.items.len() == 1 => self.occluded_item(0, &r),
             Top::One => false,
             Top::Few(set) => {
-                let mut entered = [(0, 0.0); BoxSet::CAPACITY];
-                let n = set.entered(r.o, r.d, r.t_min, r.t_max, &mut entered);
-                entered[..n]
-                    .iter()
-                    .any(|&(item, _)| self.occluded_item(item, &r))
+                // Any order will do for a shadow ray.
+                let mut mask = set.entered_mask(r.o, r.d, r.t_min, r.t_max);
+                while mask != 0 {
+                    let item = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    if self.occluded_item(item, &r) {
+                        return true;
+                    }
+                }
+                false
             }
             Top::Tree(tlas, order) => {
                 let top = obvhs::ray::Ray::new(r.o, r.d, r.t_min, r.t_max);

@@ -431,6 +431,13 @@ impl BoxSet {
         })
     }
 
+    /// The mask of the boxes the ray enters within `[t_min, t_max]` (bit `i` for box `i`).
+    #[inline]
+    pub(crate) fn entered_mask(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> u32 {
+        let (_, mask) = Prepared::new(o, d).boxes(&self.node, t_min, t_max);
+        mask & ((1u32 << self.len) - 1)
+    }
+
     /// The boxes the ray enters within `[t_min, t_max]`, as (index, entry distance), nearest
     /// first, in `out`.
     #[inline]
