@@ -2,8 +2,8 @@
 //!
 //! A render is a sequence of passes; pass `k` takes sample index `k` of every pixel. Within a
 //! pass, tiles are rendered in parallel (rayon) into their own buffers, merged in tile order
-//! into a pass accumulator (one batch of tiles merging while the next renders), and the pass is
-//! then added to the film pixel by pixel. The pass schedule depends only on the scene, never on threads or timing,
+//! into a pass accumulator (one batch of tiles merging while the next batch, of this pass or
+//! the next, renders), and the pass is then added to the film pixel by pixel. The pass schedule depends only on the scene, never on threads or timing,
 //! so a render is bit-identical for any thread count, and a render stopped after pass `k` and
 //! resumed from there equals one that ran straight through.
 
@@ -120,16 +120,42 @@ pub fn render(
     let mut passes_done = first_pass;
     let path = PathIntegrator::new(scene.description.integrator.max_depth);
 
+    let on_pass = options.on_pass;
+    let batches: Vec<&[PixelRect]> = tiles.chunks(TILES_PER_BATCH).collect();
+    if batches.is_empty() {
+        passes_done = spp;
+    }
     pool.install(|| {
-        // One pass's samples are summed here, then added to the film pixel by pixel, so a
-        // pass cut short leaves the film untouched and no per-pass copy of it is needed.
+        // A pass's samples are summed here, then added to the film pixel by pixel, so a pass
+        // cut short leaves the film untouched and no per-pass copy of it is needed.
         let mut pass_film = Film::new(scene.pixel_bounds);
+        // Rendered tile buffers not yet merged, with their pass and whether they close it.
+        // They are merged (in tile order, on one thread) while the next batch renders on the
+        // others, across pass boundaries too: the next pass's first batch is only merged once
+        // this pass has been added to the film and the accumulator cleared.
+        let mut pending: Option<(u32, Vec<TileBuffer>, bool)> = None;
+        let settle = |pending: Option<(u32, Vec<TileBuffer>, bool)>,
+                      pass_film: &mut Film,
+                      film: &mut Film,
+                      passes_done: &mut u32| {
+            let Some((pass, buffers, closes_pass)) = pending else {
+                return;
+            };
+            for b in &buffers {
+                pass_film.merge(b);
+            }
+            if closes_pass {
+                film.add(pass_film);
+                pass_film.clear();
+                *passes_done = pass + 1;
+                if let Some(f) = on_pass {
+                    f(pass + 1, spp, film);
+                }
+            }
+        };
         'passes: for pass in first_pass..spp {
-            pass_film.clear();
-            // Tile buffers rendered but not yet merged: a batch is merged (in tile order, on
-            // one thread) while the next batch renders on the others.
-            let mut pending: Vec<TileBuffer> = Vec::new();
-            for batch in tiles.chunks(TILES_PER_BATCH) {
+            for (i, batch) in batches.iter().enumerate() {
+                let previous = pending.take();
                 let (buffers, ()) = rayon::join(
                     || {
                         batch
@@ -152,29 +178,18 @@ pub fn render(
                             })
                             .collect::<Vec<Option<TileBuffer>>>()
                     },
-                    || {
-                        for b in pending.drain(..) {
-                            pass_film.merge(&b);
-                        }
-                    },
+                    || settle(previous, &mut pass_film, &mut film, &mut passes_done),
                 );
-                if buffers.iter().any(Option::is_none) {
+                if cancelled() || buffers.iter().any(Option::is_none) {
+                    // Cancelled: the pass under way is dropped (the one before it, if it was
+                    // still pending, was added to the film by the settle just done).
                     break 'passes;
                 }
-                pending = buffers.into_iter().flatten().collect();
-            }
-            for b in &pending {
-                pass_film.merge(b);
-            }
-            film.add(&pass_film);
-            passes_done = pass + 1;
-            if let Some(f) = options.on_pass {
-                f(passes_done, spp, &film);
-            }
-            if cancelled() {
-                break;
+                let closes_pass = i + 1 == batches.len();
+                pending = Some((pass, buffers.into_iter().flatten().collect(), closes_pass));
             }
         }
+        settle(pending.take(), &mut pass_film, &mut film, &mut passes_done);
     });
     Ok(RenderOutcome {
         film,
