@@ -44,7 +44,9 @@ fn write_obj(mesh: &TriangleMesh, name: &str) -> std::path::PathBuf {
 fn random_scene(seed: u64, moving_chance: f32) -> TestScene {
     let mut rng = Rng(seed);
     let soup = Arc::new(triangle_soup(&mut rng, 60, 1.0));
-    let count = 1 + rng.index(8);
+    // Up to 16 instances: the top level is one SIMD box node for up to eight items (static
+    // meshes count as one) and obvhs's tree beyond, so both are exercised.
+    let count = 1 + rng.index(16);
     let mut instances = (0..count)
         .map(|_| {
             let shape = random_shape(&mut rng, &soup);
