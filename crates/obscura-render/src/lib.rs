@@ -13,9 +13,10 @@
 //!   a pinhole image by its [`screen_buffers`], for comparison with the distributed ray tracing
 //!   that the renderer does.
 //!
-//! The decision to know: tiles accumulate into their own buffers, merged into the film in tile
-//! order after each batch, and a render is a fixed sequence of passes. So the image is
-//! bit-identical for any thread count and any tile completion order.
+//! The decision to know: tiles accumulate into their own buffers, merged in tile order into a
+//! pass accumulator that is added to the film once the pass is complete, and a render is a
+//! fixed sequence of passes. So the image is bit-identical for any thread count and any tile
+//! completion order.
 //!
 //! Not for: camera models, BVHs or BSDFs themselves (their crates), nor the command line (the
 //! `camera-obscura` package's `obscura` binary).
