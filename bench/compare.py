@@ -15,9 +15,10 @@ honoured), then in this one invocation on this one machine:
   `embreex` then builds the very same triangles and traces the very same rays, pinned to one
   core. embreex calls Embree one ray at a time from Cython, so its "miss" figure (rays that miss
   the root box) is printed as the per-call overhead that its other figures include.
-* render: `obscura render scenes/spheres-perspective.toml` at 512x512, 16 spp, and the same
-  scene written for Mitsuba 3 (`scalar_rgb`, and `llvm_ad_rgb` where libLLVM >= 15 loads), on 1
-  and 2 threads (each peer run in its own process pinned to that many cores).
+* render: `obscura render scenes/spheres-perspective.toml` at 512x512, 16 spp (as shipped, with
+  its Sobol sampler, and again with the independent sampler Mitsuba uses), and the same scene
+  written for Mitsuba 3 (`scalar_rgb`, and `llvm_ad_rgb` where libLLVM >= 15 loads), on 1 and
+  2 threads (each peer run in its own process pinned to that many cores).
 
 Prints one table with the ratios (Obscura / peer for throughput, peer / Obscura for time: above
 1.0 means Obscura is faster) and writes all figures as JSON to bench/results.json.
@@ -212,38 +213,54 @@ def row(label, ours, peer, invert=False):
 def bench_render(results):
     binary = TARGET / "release" / "obscura"
     scene = ROOT / "scenes" / "spheres-perspective.toml"
+    # The same scene with Mitsuba's sampler (independent), for a like-for-like second figure.
+    SCRATCH.mkdir(parents=True, exist_ok=True)
+    independent = SCRATCH / "spheres-perspective-independent.toml"
+    text = scene.read_text()
+    assert 'type = "sobol"' in text, "the comparison scene's sampler changed"
+    independent.write_text(text.replace('type = "sobol"', 'type = "independent"'))
     r, spp = RENDER["resolution"], RENDER["spp"]
     print(f"\nspheres-perspective, {r}x{r}, {spp} spp, path max_depth {RENDER['max_depth']}")
     print(f"  {'threads':<10}{'Obscura s':>12}{'scalar_rgb s':>14}{'ratio':>8}{'llvm_ad_rgb s':>15}{'ratio':>8}")
-    for threads in [1, 2]:
+
+    def obscura_best(path, threads):
         times = []
         for seed in range(3):
             start = time.perf_counter()
             subprocess.run(
                 ["taskset", "-c", ",".join(str(c) for c in range(threads)), str(binary),
-                 "render", str(scene), "-o", str(SCRATCH / f"obscura-{threads}t.exr"),
+                 "render", str(path), "-o", str(SCRATCH / f"obscura-{threads}t.exr"),
                  "--resolution", f"{r}x{r}", "--spp", str(spp), "--seed", str(seed),
                  "--threads", str(threads)],
                 check=True,
                 capture_output=True,
             )
             times.append(time.perf_counter() - start)
-        ours = min(times)
-        entry = {"threads": threads, "obscura_s": ours}
+        return min(times)
+
+    for threads in [1, 2]:
+        ours = obscura_best(scene, threads)
+        ours_independent = obscura_best(independent, threads)
+        entry = {"threads": threads, "obscura_s": ours, "obscura_independent_s": ours_independent}
         line = f"  {threads:<10}{ours:>12.3f}"
+        line_independent = f"  {'(indep.)':<10}{ours_independent:>12.3f}"
         for variant in ["scalar_rgb", "llvm_ad_rgb"]:
             try:
                 peer = run_json([sys.executable, __file__, "--mitsuba-worker", variant, str(threads)])
                 entry[variant] = peer
                 line += f"{peer['best_s']:>14.3f}{peer['best_s'] / ours:>8.2f}"
+                line_independent += f"{'':>14}{peer['best_s'] / ours_independent:>8.2f}"
             except (subprocess.CalledProcessError, json.JSONDecodeError) as err:
                 entry[variant] = None
                 print(f"  mitsuba {variant} unavailable: {str(err)[:200]}", file=sys.stderr)
                 line += f"{'-':>14}{'-':>8}"
+                line_independent += f"{'-':>14}{'-':>8}"
         results["render"].append(entry)
         print(line)
+        print(line_independent)
     one, two = results["render"][0]["obscura_s"], results["render"][1]["obscura_s"]
     print(f"  Obscura 2-thread speed-up: {one / two:.2f}x")
+    print("  (indep.): Obscura with the independent sampler, as Mitsuba runs; the scene uses Sobol")
 
 
 def obscura_render_time(resolution, spp, threads, runs=2):
