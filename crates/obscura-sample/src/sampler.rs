@@ -195,6 +195,7 @@ impl Sampler {
             pixel_key: self.key(pixel),
             index,
             dimension: 0,
+            sobol_last: None,
         }
     }
 }
@@ -226,6 +227,9 @@ pub struct SampleStream<'a> {
     pixel_key: u64,
     index: u32,
     dimension: u32,
+    /// Sobol only: the shared part of the pair last read one dimension at a time, so reading
+    /// its other dimension next costs one scramble (the values are the same either way).
+    sobol_last: Option<sequences::SobolPair>,
 }
 
 impl SampleStream<'_> {
@@ -237,7 +241,7 @@ impl SampleStream<'_> {
         let dims = CameraDims {
             film: sampler.pair_keyed(key, index, 0),
             lens: sampler.pair_keyed(key, index, 2),
-            time: sampler.value_keyed(key, index, 4),
+            time: self.one(4),
         };
         self.dimension = self.dimension.max(5);
         dims
@@ -246,11 +250,30 @@ impl SampleStream<'_> {
     /// The next dimension, in `[0, 1)`.
     #[inline]
     pub fn next_1d(&mut self) -> f32 {
-        let u = self
-            .sampler
-            .value_keyed(self.pixel_key, self.index, self.dimension);
+        let u = self.one(self.dimension);
         self.dimension = self.dimension.saturating_add(1);
         u
+    }
+
+    /// Dimension `dimension` alone: [`Sampler::value`], reusing the Sobol pair's shared part
+    /// when the previous single read was the same pair's other dimension.
+    #[inline]
+    fn one(&mut self, dimension: u32) -> f32 {
+        if self.sampler.kind != SamplerKind::Sobol {
+            return self
+                .sampler
+                .value_keyed(self.pixel_key, self.index, dimension);
+        }
+        let pair = dimension / 2;
+        let prepared = match self.sobol_last {
+            Some(last) if last.pair == pair => last,
+            _ => {
+                let prepared = sequences::sobol_prepare(self.pixel_key, self.index, pair);
+                self.sobol_last = Some(prepared);
+                prepared
+            }
+        };
+        sequences::sobol_coordinate(prepared, dimension % 2)
     }
 
     /// The next aligned pair of dimensions, in `[0, 1)^2`.

@@ -231,9 +231,30 @@ pub(crate) const fn sobol_second_bitwise(mut index: u32) -> u32 {
 /// `key` is the pixel's key tagged for Sobol by [`sobol_key`] (once per pixel, not per value).
 #[inline]
 pub(crate) fn sobol(key: u64, index: u32, dimension: u32) -> f32 {
-    let pair_key = combine(key, u64::from(dimension / 2));
-    let shuffled = owen_scramble(index, pair_key as u32);
-    sobol_coordinate(pair_key, shuffled, dimension % 2)
+    let prepared = sobol_prepare(key, index, dimension / 2);
+    sobol_coordinate(prepared, dimension % 2)
+}
+
+/// What both coordinates of pair `pair` share: the pair's key and the shuffled sample index.
+/// A stream keeps it, so the second coordinate of a pair read one dimension at a time costs
+/// one scramble, not three.
+#[inline]
+pub(crate) fn sobol_prepare(key: u64, index: u32, pair: u32) -> SobolPair {
+    let pair_key = combine(key, u64::from(pair));
+    SobolPair {
+        pair,
+        pair_key,
+        shuffled: owen_scramble(index, pair_key as u32),
+    }
+}
+
+/// The shared part of one Sobol pair, from [`sobol_prepare`].
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct SobolPair {
+    /// Which pair (dimensions `2 pair` and `2 pair + 1`).
+    pub pair: u32,
+    pair_key: u64,
+    shuffled: u32,
 }
 
 /// The key [`sobol`] and [`sobol_pair`] take: the pixel's key tagged for this sampler.
@@ -247,12 +268,8 @@ pub(crate) fn sobol_key(pixel_key: u64) -> u64 {
 /// third of a path-traced render's time, mostly hashing).
 #[inline]
 pub(crate) fn sobol_pair(key: u64, index: u32, pair: u32) -> [f32; 2] {
-    let pair_key = combine(key, u64::from(pair));
-    let shuffled = owen_scramble(index, pair_key as u32);
-    [
-        sobol_coordinate(pair_key, shuffled, 0),
-        sobol_coordinate(pair_key, shuffled, 1),
-    ]
+    let prepared = sobol_prepare(key, index, pair);
+    [sobol_coordinate(prepared, 0), sobol_coordinate(prepared, 1)]
 }
 
 /// Coordinate `which` (0 or 1) of the pair's (0,2)-sequence point at the shuffled index,
@@ -263,13 +280,13 @@ pub(crate) fn sobol_pair(key: u64, index: u32, pair: u32) -> [f32; 2] {
 /// reversed (the index itself, and [`sobol_second_reversed`]) and [`owen_hash`] reverses once:
 /// the same value as `owen_scramble(raw, seed)` with two bit reversals fewer.
 #[inline]
-fn sobol_coordinate(pair_key: u64, shuffled: u32, which: u32) -> f32 {
+pub(crate) fn sobol_coordinate(prepared: SobolPair, which: u32) -> f32 {
     let raw_reversed = if which == 0 {
-        shuffled
+        prepared.shuffled
     } else {
-        sobol_second_reversed(shuffled)
+        sobol_second_reversed(prepared.shuffled)
     };
-    let scramble_seed = combine(pair_key, u64::from(which) + 1) as u32;
+    let scramble_seed = combine(prepared.pair_key, u64::from(which) + 1) as u32;
     unit_f32_from_bits(owen_hash(raw_reversed, scramble_seed).reverse_bits())
 }
 

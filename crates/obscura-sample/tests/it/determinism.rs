@@ -184,4 +184,31 @@ proptest! {
         prop_assert_eq!(stream.next_1d(), v(8));
         prop_assert_eq!(stream.next_2d(), Vec2::new(v(10), v(11)));
     }
+
+    /// Any mix of single and paired reads gives exactly the sampler's values for the
+    /// dimensions read (the stream keeps a Sobol pair's shared part between single reads;
+    /// that must never change a value).
+    #[test]
+    fn any_mix_of_reads_gives_the_sampler_values(
+        kind in prop::sample::select(SamplerKind::ALL.to_vec()),
+        seed: u64, pixel: [u32; 2], index in 0u32..1000,
+        reads in prop::collection::vec(any::<bool>(), 1..24),
+    ) {
+        let s = sampler(kind, 16, seed);
+        let v = |d| s.value(pixel, index, d).to_bits();
+        let mut stream = s.stream(pixel, index);
+        if reads[0] {
+            stream.camera();
+        }
+        for &single in &reads[1..] {
+            if single {
+                let d = stream.dimension();
+                prop_assert_eq!(stream.next_1d().to_bits(), v(d));
+            } else {
+                let first = stream.dimension() + stream.dimension() % 2;
+                let u2 = stream.next_2d();
+                prop_assert_eq!((u2.x.to_bits(), u2.y.to_bits()), (v(first), v(first + 1)));
+            }
+        }
+    }
 }
