@@ -19,6 +19,8 @@ pub struct Filter {
     settings: FilterSettings,
     /// For the Gaussian: `exp(-r^2 / (2 sigma^2))`, subtracted so the filter reaches 0 at r.
     gaussian_floor: f32,
+    /// For the Gaussian: `1 / (2 sigma^2)`.
+    gaussian_rate: f32,
 }
 
 impl Filter {
@@ -29,6 +31,7 @@ impl Filter {
         Self {
             settings,
             gaussian_floor: (-(r * r) / (2.0 * sigma * sigma)).exp(),
+            gaussian_rate: 1.0 / (2.0 * sigma * sigma),
         }
     }
 
@@ -53,8 +56,7 @@ impl Filter {
             FilterSettings::Box { .. } => 1.0,
             FilterSettings::Triangle { .. } => 1.0 - a / r,
             FilterSettings::Gaussian { .. } => {
-                let sigma = r / 3.0;
-                ((-(a * a) / (2.0 * sigma * sigma)).exp() - self.gaussian_floor).max(0.0)
+                ((-(a * a) * self.gaussian_rate).exp() - self.gaussian_floor).max(0.0)
             }
             FilterSettings::Mitchell { .. } => mitchell(2.0 * a / r),
         }
@@ -189,9 +191,9 @@ impl TileBuffer {
     pub fn add_sample(&mut self, p: Vec2, l: Vec3, hit: bool) {
         let r = self.filter.radius();
         // Pixels whose centre i + 0.5 lies in (p - r, p + r].
-        let lo = ((p - Vec2::splat(r + 0.5)).floor() + Vec2::ONE)
+        let lo = (floor(p - Vec2::splat(r + 0.5)) + Vec2::ONE)
             .max(Vec2::new(self.rect.x0 as f32, self.rect.y0 as f32));
-        let hi = (p + Vec2::splat(r - 0.5)).floor().min(Vec2::new(
+        let hi = floor(p + Vec2::splat(r - 0.5)).min(Vec2::new(
             self.rect.x1 as f32 - 1.0,
             self.rect.y1 as f32 - 1.0,
         ));
@@ -199,29 +201,47 @@ impl TileBuffer {
             return;
         }
         let (l, coverage) = (l.extend(1.0), if hit { 1.0 } else { 0.0 });
-        // The column weights are the same for every row: evaluate them once (for footprints
-        // up to COLUMNS wide, which covers every filter at its default radius).
-        const COLUMNS: usize = 8;
         let (x0, x1) = (lo.x as u32, hi.x as u32);
-        let mut wx = [0f32; COLUMNS];
-        let cached = ((x1 - x0) as usize) < COLUMNS;
-        if cached {
-            for (k, w) in wx.iter_mut().enumerate().take((x1 - x0) as usize + 1) {
-                *w = self.filter.eval_1d(p.x - ((x0 + k as u32) as f32 + 0.5));
-            }
+        let (y0, y1) = (lo.y as u32, hi.y as u32);
+        // The profile is separable: evaluate each column's and each row's weight once (for
+        // footprints up to SPAN wide, which covers every filter at its default radius).
+        const SPAN: usize = 8;
+        let (nx, ny) = ((x1 - x0) as usize + 1, (y1 - y0) as usize + 1);
+        if nx > SPAN || ny > SPAN {
+            return self.add_sample_wide(p, l, coverage, [x0, x1], [y0, y1]);
         }
-        for y in lo.y as u32..=hi.y as u32 {
+        let mut wx = [0f32; SPAN];
+        for (k, w) in wx.iter_mut().enumerate().take(nx) {
+            *w = self.filter.eval_1d(p.x - ((x0 + k as u32) as f32 + 0.5));
+        }
+        let width = self.rect.width() as usize;
+        for j in 0..ny {
+            let y = y0 + j as u32;
             let wy = self.filter.eval_1d(p.y - (y as f32 + 0.5));
             if wy == 0.0 {
                 continue;
             }
-            for x in x0..=x1 {
-                let w_col = if cached {
-                    wx[(x - x0) as usize]
-                } else {
-                    self.filter.eval_1d(p.x - (x as f32 + 0.5))
-                };
+            let row = (y - self.rect.y0) as usize * width + (x0 - self.rect.x0) as usize;
+            for (s, &w_col) in self.sums[row..row + nx].iter_mut().zip(&wx[..nx]) {
                 let w = wy * w_col;
+                if w != 0.0 {
+                    s.weighted += l * w;
+                    s.coverage += w * coverage;
+                }
+            }
+        }
+    }
+
+    /// [`TileBuffer::add_sample`] for footprints wider than its fixed weight arrays (filters
+    /// given a large radius).
+    fn add_sample_wide(&mut self, p: Vec2, l: Vec4, coverage: f32, xs: [u32; 2], ys: [u32; 2]) {
+        for y in ys[0]..=ys[1] {
+            let wy = self.filter.eval_1d(p.y - (y as f32 + 0.5));
+            if wy == 0.0 {
+                continue;
+            }
+            for x in xs[0]..=xs[1] {
+                let w = wy * self.filter.eval_1d(p.x - (x as f32 + 0.5));
                 if w == 0.0 {
                     continue;
                 }
@@ -232,6 +252,17 @@ impl TileBuffer {
             }
         }
     }
+}
+
+/// `v.floor()` per lane without a libm call (x86-64's baseline has no rounding instruction):
+/// exact for `|x| < 2^31`, which raster positions are.
+#[inline]
+fn floor(v: Vec2) -> Vec2 {
+    let f = |x: f32| {
+        let t = x as i32 as f32;
+        if t > x { t - 1.0 } else { t }
+    };
+    Vec2::new(f(v.x), f(v.y))
 }
 
 /// The whole film's sums over its pixel bounds (the crop window).
@@ -417,5 +448,55 @@ mod tests {
         assert!(film.sums()[3 * 8 + 3].weight > 0.0);
         // Pixel (2, 2), centre (2.5, 2.5), is 1.6 away: outside.
         assert_eq!(film.sums()[2 * 8 + 2].weight, 0.0);
+    }
+
+    #[test]
+    fn floor_matches_the_library_floor() {
+        for x in [
+            -3.0f32,
+            -2.5,
+            -1.0,
+            -0.75,
+            -0.0,
+            0.0,
+            0.25,
+            1.0,
+            1.999_999,
+            2.0,
+            1e6 + 0.5,
+        ] {
+            let got = floor(Vec2::new(x, -x));
+            assert_eq!(got, Vec2::new(x.floor(), (-x).floor()), "{x}");
+        }
+    }
+
+    /// Every pixel gets exactly the separable weight `f(dx) f(dy)` of the sample, for a
+    /// footprint within the fixed weight arrays and for one wider than them.
+    #[test]
+    fn splat_weights_are_the_filter_product_narrow_and_wide() {
+        for settings in [
+            FilterSettings::Gaussian { radius: 1.5 },
+            FilterSettings::Triangle { radius: 5.3 },
+        ] {
+            let filter = Filter::new(settings);
+            let film_r = film_rect(24, 24);
+            let mut tile = TileBuffer::new(film_r, film_r, filter);
+            let p = Vec2::new(11.3, 12.8);
+            tile.add_sample(p, Vec3::new(2.0, 0.0, 0.0), true);
+            let mut film = Film::new(film_r);
+            film.merge(&tile);
+            let mut touched = 0;
+            for y in 0..24u32 {
+                for x in 0..24u32 {
+                    let want = filter.eval_1d(p.x - (x as f32 + 0.5))
+                        * filter.eval_1d(p.y - (y as f32 + 0.5));
+                    let s = film.sums()[(y * 24 + x) as usize];
+                    assert_eq!(s.weight, f64::from(want), "{settings:?} at ({x}, {y})");
+                    assert_eq!(s.radiance[0], f64::from(want * 2.0));
+                    touched += usize::from(want != 0.0);
+                }
+            }
+            assert!(touched >= 9, "{settings:?}: {touched} pixels");
+        }
     }
 }
