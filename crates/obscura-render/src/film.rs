@@ -172,18 +172,28 @@ struct TileSums {
 impl TileBuffer {
     /// A zeroed buffer for samples of the pixels in `tile`, on a film covering `film`.
     pub fn new(tile: PixelRect, film: PixelRect, filter: Filter) -> Self {
-        let m = filter.radius().ceil() as u32;
-        let rect = PixelRect {
+        let mut buffer = Self {
+            rect: tile,
+            filter,
+            sums: Vec::new(),
+        };
+        buffer.reset(tile, film);
+        buffer
+    }
+
+    /// Makes this buffer a zeroed one for `tile`, as [`TileBuffer::new`] would, keeping its
+    /// memory (the renderer recycles buffers instead of allocating one per tile and pass).
+    pub fn reset(&mut self, tile: PixelRect, film: PixelRect) {
+        let m = self.filter.radius().ceil() as u32;
+        self.rect = PixelRect {
             x0: tile.x0.saturating_sub(m).max(film.x0),
             y0: tile.y0.saturating_sub(m).max(film.y0),
             x1: (tile.x1 + m).min(film.x1),
             y1: (tile.y1 + m).min(film.y1),
         };
-        Self {
-            rect,
-            filter,
-            sums: vec![TileSums::default(); rect.area() as usize],
-        }
+        self.sums.clear();
+        self.sums
+            .resize(self.rect.area() as usize, TileSums::default());
     }
 
     /// Adds a sample at raster position `p` with radiance `l` into every pixel the filter

@@ -16,6 +16,7 @@ use obscura_sample::SampleStream;
 use obscura_shade::PathIntegrator;
 use obscura_space::{Point2, Ray, World};
 use rayon::prelude::*;
+use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
@@ -134,6 +135,7 @@ pub fn render(
         // others, across pass boundaries too: the next pass's first batch is only merged once
         // this pass has been added to the film and the accumulator cleared.
         let mut pending: Option<(u32, Vec<TileBuffer>, bool)> = None;
+        let spare: Mutex<Vec<TileBuffer>> = Mutex::new(Vec::new());
         let settle = |pending: Option<(u32, Vec<TileBuffer>, bool)>,
                       pass_film: &mut Film,
                       film: &mut Film,
@@ -143,6 +145,11 @@ pub fn render(
             };
             for b in &buffers {
                 pass_film.merge(b);
+            }
+            // Merged buffers go back for reuse: no allocation, and no fresh pages to fault in,
+            // per tile and pass.
+            if let Ok(mut s) = spare.lock() {
+                s.extend(buffers);
             }
             if closes_pass {
                 film.add(pass_film);
@@ -164,8 +171,14 @@ pub fn render(
                                 if cancelled() {
                                     return None;
                                 }
-                                let mut buffer =
-                                    TileBuffer::new(tile, scene.pixel_bounds, scene.filter);
+                                let recycled = spare.lock().ok().and_then(|mut s| s.pop());
+                                let mut buffer = match recycled {
+                                    Some(mut b) => {
+                                        b.reset(tile, scene.pixel_bounds);
+                                        b
+                                    }
+                                    None => TileBuffer::new(tile, scene.pixel_bounds, scene.filter),
+                                };
                                 let counts = render_tile(scene, &path, tile, pass, &mut buffer);
                                 samples.fetch_add(counts.samples, Ordering::Relaxed);
                                 dropped.fetch_add(counts.dropped_nonfinite, Ordering::Relaxed);
