@@ -711,14 +711,7 @@ impl Scene {
                     .expect("moving mesh instances are meshes");
                 let world_from_object = world_from_object.at(r.time);
                 let (p_object, err_object) = edge_point(&hit);
-                let (p, p_error) =
-                    transform_point_with_error(&world_from_object.matrix(), p_object, err_object);
-                let p_error = p_error
-                    + object_space_error(
-                        &world_from_object.matrix(),
-                        &world_from_object.inverse_matrix(),
-                        p,
-                    );
+                let (p, p_error) = point_to_world(&world_from_object, p_object, err_object);
                 let n_geo = normal_to_world(&world_from_object, hit.e1.cross(hit.e2));
                 self.triangle_hit(
                     r,
@@ -828,14 +821,7 @@ impl Scene {
         let (p, p_error, n) = if world_from_object.is_identity() {
             (p_object, err_object, n_object.normalize())
         } else {
-            let (p, p_error) =
-                transform_point_with_error(&world_from_object.matrix(), p_object, err_object);
-            let p_error = p_error
-                + object_space_error(
-                    &world_from_object.matrix(),
-                    &world_from_object.inverse_matrix(),
-                    p,
-                );
+            let (p, p_error) = point_to_world(world_from_object, p_object, err_object);
             (p, p_error, normal_to_world(world_from_object, n_object))
         };
         let n = Normal3::from_glam(n);
@@ -902,6 +888,22 @@ fn to_object(object_from_world: &Transform<Object, World>, r: &PlainRay) -> (Vec
     (
         Vec3A::from(m.transform_point3(Vec3::from(r.o))),
         Vec3A::from(m.transform_vector3(Vec3::from(r.d))),
+    )
+}
+
+/// A hit point found in object space, carried to world space with its error bound: the
+/// rounding of the transform itself plus that of having carried the ray into object space.
+#[inline]
+fn point_to_world(
+    world_from_object: &Transform<World, Object>,
+    p_object: Vec3,
+    err_object: Vec3,
+) -> (Vec3, Vec3) {
+    let m = world_from_object.matrix();
+    let (p, p_error) = transform_point_with_error(&m, p_object, err_object);
+    (
+        p,
+        p_error + object_space_error(&m, &world_from_object.inverse_matrix(), p),
     )
 }
 

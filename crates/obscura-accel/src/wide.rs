@@ -37,6 +37,49 @@ thread_local! {
     static ANY_STACK: Cell<Vec<u32>> = const { Cell::new(Vec::new()) };
 }
 
+/// The lanes set in `mask`, each named by `name(lane)` with its entry distance from `t_near`,
+/// into `out` sorted nearest first (insertion sort: at most eight); returns how many.
+#[inline(always)]
+fn by_entry<T: Copy>(
+    mask: u32,
+    t_near: [Vec4; 2],
+    name: impl Fn(usize) -> T,
+    out: &mut [(T, f32); ARITY],
+) -> usize {
+    let t_near = [t_near[0].to_array(), t_near[1].to_array()];
+    let mut n = 0;
+    let mut m = mask;
+    while m != 0 {
+        let lane = m.trailing_zeros() as usize & 7;
+        m &= m - 1;
+        let entry = (name(lane), t_near[lane >> 2][lane & 3]);
+        let mut k = n;
+        while k > 0 && out[k - 1].1 > entry.1 {
+            out[k] = out[k - 1];
+            k -= 1;
+        }
+        out[k] = entry;
+        n += 1;
+    }
+    n
+}
+
+/// Runs `query` with this thread's (emptied) stack from `key`. The stack is taken, not
+/// borrowed, so a nested query (none today) would simply get a fresh one.
+#[inline(always)]
+fn with_stack<T, R>(
+    key: &'static std::thread::LocalKey<Cell<Vec<T>>>,
+    query: impl FnOnce(&mut Vec<T>) -> R,
+) -> R {
+    key.with(|cell| {
+        let mut stack = cell.take();
+        stack.clear();
+        let result = query(&mut stack);
+        cell.set(stack);
+        result
+    })
+}
+
 /// Set in a child reference that names a leaf packet rather than a node.
 const LEAF: u32 = 1 << 31;
 /// The child reference of an unused lane (its box is empty, so it is never entered).
@@ -59,6 +102,29 @@ struct Node {
     bounds: [[Vec4; 2]; 6],
     /// A node index, `LEAF | packet index`, or `EMPTY`.
     child: [u32; ARITY],
+}
+
+impl Node {
+    /// A node with every lane unused (empty boxes, so no ray enters them).
+    const EMPTY: Node = Node {
+        bounds: [
+            [Vec4::INFINITY; 2],
+            [Vec4::NEG_INFINITY; 2],
+            [Vec4::INFINITY; 2],
+            [Vec4::NEG_INFINITY; 2],
+            [Vec4::INFINITY; 2],
+            [Vec4::NEG_INFINITY; 2],
+        ],
+        child: [EMPTY; ARITY],
+    };
+
+    /// Puts `aabb` in lane `lane`.
+    fn set_box(&mut self, lane: usize, aabb: &Aabb) {
+        for axis in 0..3 {
+            self.bounds[2 * axis][lane >> 2][lane & 3] = aabb.min[axis];
+            self.bounds[2 * axis + 1][lane >> 2][lane & 3] = aabb.max[axis];
+        }
+    }
 }
 
 /// Up to four triangles, one lane each: the first vertex and the two edges from it.
@@ -214,26 +280,15 @@ impl WideBvh {
     /// The closest triangle hit with `t` in `[t_min, t_max]`.
     #[inline]
     pub(crate) fn closest(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> Option<WideHit> {
-        CLOSEST_STACK.with(|cell| {
-            // Taken, not borrowed: a nested query (none today) would get a fresh stack.
-            let mut stack = cell.take();
-            stack.clear();
-            let found = self.closest_with(&mut stack, o, d, t_min, t_max);
-            cell.set(stack);
-            found
+        with_stack(&CLOSEST_STACK, |stack| {
+            self.closest_with(stack, o, d, t_min, t_max)
         })
     }
 
     /// True when any triangle is hit with `t` in `[t_min, t_max]`; stops at the first found.
     #[inline]
     pub(crate) fn any(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> bool {
-        ANY_STACK.with(|cell| {
-            let mut stack = cell.take();
-            stack.clear();
-            let hit = self.any_with(&mut stack, o, d, t_min, t_max);
-            cell.set(stack);
-            hit
-        })
+        with_stack(&ANY_STACK, |stack| self.any_with(stack, o, d, t_min, t_max))
     }
 
     /// Front-to-back traversal: of the children a ray enters, the nearest is visited next and
@@ -263,22 +318,8 @@ impl WideBvh {
                         continue;
                     }
                     // Two to eight children: sort them by entry distance, nearest first.
-                    let t_near = [t_near[0].to_array(), t_near[1].to_array()];
                     let mut hits = [(0u32, 0f32); ARITY];
-                    let mut n = 0;
-                    let mut m = mask;
-                    while m != 0 {
-                        let lane = m.trailing_zeros() as usize & 7;
-                        m &= m - 1;
-                        let entry = (node.child[lane], t_near[lane >> 2][lane & 3]);
-                        let mut k = n;
-                        while k > 0 && hits[k - 1].1 > entry.1 {
-                            hits[k] = hits[k - 1];
-                            k -= 1;
-                        }
-                        hits[k] = entry;
-                        n += 1;
-                    }
+                    let n = by_entry(mask, t_near, |lane| node.child[lane], &mut hits);
                     for &entry in hits[1..n].iter().rev() {
                         warm ^= self.touch(entry.0);
                         stack.push(entry);
@@ -413,23 +454,10 @@ impl BoxSet {
         if boxes.len() > ARITY {
             return None;
         }
-        let mut node = Node {
-            bounds: [
-                [Vec4::INFINITY; 2],
-                [Vec4::NEG_INFINITY; 2],
-                [Vec4::INFINITY; 2],
-                [Vec4::NEG_INFINITY; 2],
-                [Vec4::INFINITY; 2],
-                [Vec4::NEG_INFINITY; 2],
-            ],
-            child: [EMPTY; ARITY],
-        };
+        let mut node = Node::EMPTY;
         for (lane, aabb) in boxes.iter().enumerate() {
+            node.set_box(lane, aabb);
             node.child[lane] = lane as u32;
-            for axis in 0..3 {
-                node.bounds[2 * axis][lane >> 2][lane & 3] = aabb.min[axis];
-                node.bounds[2 * axis + 1][lane >> 2][lane & 3] = aabb.max[axis];
-            }
         }
         Some(BoxSet {
             node,
@@ -456,22 +484,7 @@ impl BoxSet {
         out: &mut [(usize, f32); ARITY],
     ) -> usize {
         let (t_near, mask) = Prepared::new(o, d).boxes(&self.node, t_min, t_max);
-        let t_near = [t_near[0].to_array(), t_near[1].to_array()];
-        let mut n = 0;
-        let mut m = mask & ((1u32 << self.len) - 1);
-        while m != 0 {
-            let lane = m.trailing_zeros() as usize & 7;
-            m &= m - 1;
-            let entry = (lane, t_near[lane >> 2][lane & 3]);
-            let mut k = n;
-            while k > 0 && out[k - 1].1 > entry.1 {
-                out[k] = out[k - 1];
-                k -= 1;
-            }
-            out[k] = entry;
-            n += 1;
-        }
-        n
+        by_entry(mask & ((1u32 << self.len) - 1), t_near, |lane| lane, out)
     }
 }
 
@@ -639,23 +652,9 @@ impl<'a> Collapse<'a> {
         out.root = self.reference(0, out, &mut work);
         while let Some((b2, wide)) = work.pop() {
             let kids = self.open(b2);
-            let mut node = Node {
-                bounds: [
-                    [Vec4::INFINITY; 2],
-                    [Vec4::NEG_INFINITY; 2],
-                    [Vec4::INFINITY; 2],
-                    [Vec4::NEG_INFINITY; 2],
-                    [Vec4::INFINITY; 2],
-                    [Vec4::NEG_INFINITY; 2],
-                ],
-                child: [EMPTY; ARITY],
-            };
+            let mut node = Node::EMPTY;
             for (lane, &kid) in kids.iter().enumerate() {
-                let aabb = self.bvh2.nodes[kid as usize].aabb;
-                for axis in 0..3 {
-                    node.bounds[2 * axis][lane >> 2][lane & 3] = aabb.min[axis];
-                    node.bounds[2 * axis + 1][lane >> 2][lane & 3] = aabb.max[axis];
-                }
+                node.set_box(lane, &self.bvh2.nodes[kid as usize].aabb);
             }
             // Children are numbered before any grandchild, so siblings sit side by side.
             let first_new = work.len();
@@ -677,10 +676,7 @@ impl<'a> Collapse<'a> {
             LEAF | (out.packets.len() as u32 - 1)
         } else {
             let wide = out.nodes.len() as u32;
-            out.nodes.push(Node {
-                bounds: [[Vec4::ZERO; 2]; 6],
-                child: [EMPTY; ARITY],
-            });
+            out.nodes.push(Node::EMPTY);
             work.push((b2, wide));
             wide
         }
