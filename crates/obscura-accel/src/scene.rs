@@ -726,15 +726,11 @@ impl Scene {
                 )
             }
             Found::Sphere { item, t } => {
-                let (instance, shape, world_from_object) = self.analytic(item, r.time);
+                let (instance, shape, xform) = self.analytic(item);
                 let Analytic::Sphere { center, radius } = shape else {
                     unreachable!("Found::Sphere comes from a sphere")
                 };
-                let (o, d) = if world_from_object.is_identity() {
-                    (r.o, r.d)
-                } else {
-                    to_object(&world_from_object.inverse(), r)
-                };
+                let (o, d) = xform.ray_to_object(r);
                 let p_hit = Vec3::from(o + d * t);
                 // Reproject onto the surface: the error is then that of the projection.
                 let mut rel = p_hit - center;
@@ -756,19 +752,10 @@ impl Scene {
                     phi / (2.0 * core::f32::consts::PI),
                     theta / core::f32::consts::PI,
                 );
-                self.analytic_hit(
-                    r,
-                    t,
-                    p_object,
-                    err_object,
-                    n_object,
-                    uv,
-                    instance,
-                    &world_from_object,
-                )
+                self.analytic_hit(r, t, p_object, err_object, n_object, uv, instance, xform)
             }
             Found::Quad { item, quad } => {
-                let (instance, shape, world_from_object) = self.analytic(item, r.time);
+                let (instance, shape, xform) = self.analytic(item);
                 let Analytic::Quad {
                     origin,
                     edge_u,
@@ -783,26 +770,19 @@ impl Scene {
                 let n_object = edge_u.cross(edge_v);
                 let uv = Vec2::new(quad.s, quad.v);
                 self.analytic_hit(
-                    r,
-                    quad.t,
-                    p_object,
-                    err_object,
-                    n_object,
-                    uv,
-                    instance,
-                    &world_from_object,
+                    r, quad.t, p_object, err_object, n_object, uv, instance, xform,
                 )
             }
         }
     }
 
-    fn analytic(&self, item: usize, time: f32) -> (u32, Analytic, Transform<World, Object>) {
+    fn analytic(&self, item: usize) -> (u32, Analytic, &Xform) {
         match &self.items[item] {
             Item::Analytic {
                 instance,
                 shape,
                 xform,
-            } => (*instance, *shape, xform.at(time)),
+            } => (*instance, *shape, xform),
             _ => unreachable!("analytic hits come from analytic items"),
         }
     }
@@ -816,13 +796,16 @@ impl Scene {
         n_object: Vec3,
         uv: Vec2,
         instance: u32,
-        world_from_object: &Transform<World, Object>,
+        xform: &Xform,
     ) -> Hit {
-        let (p, p_error, n) = if world_from_object.is_identity() {
-            (p_object, err_object, n_object.normalize())
-        } else {
-            let (p, p_error) = point_to_world(world_from_object, p_object, err_object);
-            (p, p_error, normal_to_world(world_from_object, n_object))
+        let (p, p_error, n) = match xform {
+            // Object space is world space: nothing to carry, no rounding to add.
+            Xform::Identity => (p_object, err_object, n_object.normalize()),
+            _ => {
+                let world_from_object = xform.at(r.time);
+                let (p, p_error) = point_to_world(&world_from_object, p_object, err_object);
+                (p, p_error, normal_to_world(&world_from_object, n_object))
+            }
         };
         let n = Normal3::from_glam(n);
         Hit {
