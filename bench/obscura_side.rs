@@ -3,8 +3,9 @@
 //! `cargo run --release --example obscura-side -- MESH SIZE DIR` builds the generated mesh
 //! (`icosphere` with SIZE subdivisions, or `grid` of SIZE x SIZE quads), writes it and the ray
 //! sets to DIR as raw little-endian arrays so the peers trace exactly the same data, then
-//! measures build time and one-thread closest-hit and occlusion throughput and prints one JSON
-//! object on stdout. Run by hand, never by the test suite.
+//! measures build time and one-thread throughput of the closest hit (the full `Hit`, and the
+//! preliminary hit: distance, ids and barycentrics, what `rtcIntersect1` returns) and of
+//! occlusion, and prints one JSON object on stdout. Run by hand, never by the test suite.
 
 use camera_obscura::accel::{Placement, Scene, SceneBuilder, Shape, TriangleMesh, testmesh};
 use camera_obscura::space::{Point3, Ray, Transform, Vector3, World};
@@ -66,9 +67,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for (name, rays) in &sets {
         let closest = rate(rays, |r| scene.intersect(r).is_some());
         let occluded = rate(rays, |r| scene.occluded(r));
+        let preliminary = rate(rays, |r| scene.intersect_preliminary(r).is_some());
         let hits = rays.iter().filter(|r| scene.intersect(r).is_some()).count();
         out += &format!(
-            ", \"{name}_closest_rps\": {closest:.1}, \"{name}_occluded_rps\": {occluded:.1}, \"{name}_hits\": {hits}"
+            ", \"{name}_closest_rps\": {closest:.1}, \"{name}_preliminary_rps\": {preliminary:.1}, \"{name}_occluded_rps\": {occluded:.1}, \"{name}_hits\": {hits}"
         );
     }
     out += "}";

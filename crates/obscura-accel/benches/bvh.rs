@@ -64,6 +64,13 @@ fn bench(c: &mut Criterion) {
             trace.bench_function(format!("{name}_closest"), |b| {
                 b.iter(|| rays.iter().filter(|r| scene.intersect(r).is_some()).count())
             });
+            trace.bench_function(format!("{name}_closest_preliminary"), |b| {
+                b.iter(|| {
+                    rays.iter()
+                        .filter(|r| scene.intersect_preliminary(r).is_some())
+                        .count()
+                })
+            });
             trace.bench_function(format!("{name}_shadow_anyhit"), |b| {
                 b.iter(|| rays.iter().filter(|r| scene.occluded(r)).count())
             });

@@ -10,7 +10,9 @@
 //! - Shapes: [`TriangleMesh`] (built by [`TriangleMesh::new`] or [`load_obj`]), and the
 //!   variants of [`Shape`].
 //! - Scenes: [`SceneBuilder`] takes shapes with a [`Placement`] and builds a [`Scene`], which
-//!   answers [`Scene::intersect`] and [`Scene::occluded`] from any number of threads.
+//!   answers [`Scene::intersect`] and [`Scene::occluded`] from any number of threads;
+//!   [`Scene::intersect_preliminary`] finds the same closest hit without building its full
+//!   record (distance, ids and barycentrics only, like Embree's `rtcIntersect1`).
 //! - Hits: [`Hit`] carries the world-space point with a conservative error bound, and
 //!   [`Hit::spawn_ray`] / [`Hit::spawn_ray_to`] offset new rays by that bound (pbrt's method), so
 //!   a surface does not shadow itself.
@@ -62,4 +64,6 @@ pub use error::AccelError;
 pub use hit::{Hit, SHADOW_EPSILON};
 pub use mesh::TriangleMesh;
 pub use obj::{load_obj, parse_obj};
-pub use scene::{BuildQuality, MAX_COORDINATE, Placement, Scene, SceneBuilder, Shape};
+pub use scene::{
+    BuildQuality, MAX_COORDINATE, Placement, PreliminaryHit, Scene, SceneBuilder, Shape,
+};

@@ -483,7 +483,7 @@ impl Found {
 }
 
 /// A world ray as plain glam values, checked once.
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, Debug)]
 struct PlainRay {
     o: Vec3A,
     d: Vec3A,
@@ -513,13 +513,118 @@ impl PlainRay {
     }
 }
 
+/// The closest hit a [`Scene::intersect_preliminary`] query found, before the full [`Hit`] is
+/// built: cheap to get (no mesh data is read) and turned into the `Hit` by
+/// [`complete`](PreliminaryHit::complete), exactly as [`Scene::intersect`] would have
+/// returned it. It borrows the scene, so it cannot be completed against another.
+#[derive(Clone, Copy, Debug)]
+pub struct PreliminaryHit<'a> {
+    scene: &'a Scene,
+    ray: PlainRay,
+    found: Found,
+}
+
+impl PreliminaryHit<'_> {
+    /// The ray parameter of the hit (as [`Hit::t`]).
+    pub fn t(&self) -> f32 {
+        self.found.t()
+    }
+
+    /// The instance hit (as [`Hit::instance`]).
+    pub fn instance(&self) -> u32 {
+        match self.found {
+            Found::Flat { hit } => hit.ids[1],
+            Found::Moving { item, .. } | Found::Sphere { item, .. } | Found::Quad { item, .. } => {
+                match &self.scene.items[item] {
+                    Item::Analytic { instance, .. } | Item::MovingMesh { instance, .. } => {
+                        *instance
+                    }
+                    Item::Flat => unreachable!("flattened triangles are found as Found::Flat"),
+                }
+            }
+        }
+    }
+
+    /// The triangle hit within its mesh, 0 for spheres and quads (as [`Hit::primitive`]).
+    pub fn primitive(&self) -> u32 {
+        match self.found {
+            Found::Flat { hit } | Found::Moving { hit, .. } => hit.ids[0],
+            Found::Sphere { .. } | Found::Quad { .. } => 0,
+        }
+    }
+
+    /// The primitive's own coordinates of the hit: for a triangle the barycentrics `(b1, b2)`
+    /// of its vertices 1 and 2, for a quad `(s, t)` along `edge_u` and `edge_v`; zero for a
+    /// sphere, whose coordinates need the hit point (see [`Hit::uv`]).
+    pub fn primitive_uv(&self) -> Vec2 {
+        match self.found {
+            Found::Flat { hit } | Found::Moving { hit, .. } => Vec2::new(hit.tri.b1, hit.tri.b2),
+            Found::Quad { quad, .. } => Vec2::new(quad.s, quad.v),
+            Found::Sphere { .. } => Vec2::ZERO,
+        }
+    }
+
+    /// The full hit record: point and error bound, normals, surface coordinates.
+    pub fn complete(&self) -> Hit {
+        self.scene.finish(&self.ray, self.found)
+    }
+}
+
 impl Scene {
     /// The closest hit with `t` in `[t_min, t_max]`, moving instances placed at the ray's time.
     /// `None` for a miss, and for rays that cannot hit anything (non-finite origin or
     /// direction, zero direction, NaN or empty range).
+    ///
+    /// The same as [`intersect_preliminary`](Scene::intersect_preliminary) followed by
+    /// [`PreliminaryHit::complete`].
     pub fn intersect(&self, ray: &Ray<World>) -> Option<Hit> {
         let r = PlainRay::new(ray)?;
-        let found = match &self.tlas {
+        let found = self.found(&r)?;
+        Some(self.finish(&r, found))
+    }
+
+    /// The closest hit as [`intersect`](Scene::intersect) finds it, before its full record is
+    /// built: the distance, the instance and primitive, and the primitive's own coordinates,
+    /// with no mesh data read (the role of Embree's `rtcIntersect1` or Mitsuba's preliminary
+    /// intersection). For queries that need only what was hit and how far away (depth and id
+    /// buffers, lidar returns), and for deciding which hits deserve
+    /// [`complete`](PreliminaryHit::complete).
+    ///
+    /// ```
+    /// use obscura_accel::{Placement, SceneBuilder, Shape};
+    /// use obscura_space::{Point3, Ray, Transform, Vector3, World};
+    /// use obscura_space::glam::Vec3;
+    ///
+    /// let mut builder = SceneBuilder::new();
+    /// let quad = Shape::Quad {
+    ///     origin: Vec3::new(-1.0, -1.0, 0.0),
+    ///     edge_u: Vec3::new(2.0, 0.0, 0.0),
+    ///     edge_v: Vec3::new(0.0, 2.0, 0.0),
+    /// };
+    /// let id = builder.add(quad, Placement::Static(Transform::IDENTITY))?;
+    /// let scene = builder.build()?;
+    /// let ray = Ray::<World>::new(Point3::new(0.5, 0.0, 3.0), Vector3::new(0.0, 0.0, -1.0), 0.0);
+    /// let found = scene.intersect_preliminary(&ray).expect("the ray meets the quad");
+    /// assert_eq!((found.instance(), found.t()), (id, 3.0));
+    /// assert_eq!(found.primitive_uv().to_array(), [0.75, 0.5]);
+    /// assert_eq!(found.complete(), scene.intersect(&ray).unwrap());
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn intersect_preliminary(&self, ray: &Ray<World>) -> Option<PreliminaryHit<'_>> {
+        let r = PlainRay::new(ray)?;
+        let found = self.found(&r)?;
+        Some(PreliminaryHit {
+            scene: self,
+            ray: r,
+            found,
+        })
+    }
+
+    /// The closest hit on any item, before its record is built.
+    #[inline]
+    fn found(&self, r: &PlainRay) -> Option<Found> {
+        let r = *r;
+        match &self.tlas {
             Top::One if self.items.len() == 1 => self.intersect_item(0, &r, r.t_max),
             Top::One => None,
             Top::Few(set) => {
@@ -552,8 +657,7 @@ impl Scene {
                 });
                 best
             }
-        }?;
-        Some(self.finish(&r, found))
+        }
     }
 
     /// True when anything is hit with `t` in `[t_min, t_max]` (for shadow rays); stops at the

@@ -8,7 +8,7 @@
 //! report nothing only when nothing is robustly hit.
 
 use glam::{DMat4, Vec2, Vec3};
-use obscura_accel::{Placement, Scene, SceneBuilder, Shape, TriangleMesh};
+use obscura_accel::{Hit, Placement, Scene, SceneBuilder, Shape, TriangleMesh};
 use obscura_space::{Object, Ray, Transform, World};
 use std::sync::Arc;
 
@@ -199,6 +199,7 @@ pub fn check_ray(scene: &TestScene, ray: &Ray<World>) -> Result<(), String> {
             }
         }
     }
+    check_preliminary(scene, ray, hit.as_ref())?;
     let any_possible = all.iter().any(|c| possible(ray, c));
     let occluded = scene.scene.occluded(ray);
     if nearest_robust.is_finite() && !occluded {
@@ -215,6 +216,68 @@ pub fn check_ray(scene: &TestScene, ray: &Ray<World>) -> Result<(), String> {
         return Err(format!(
             "occluded() = {occluded} disagrees with intersect() ({ray:?})"
         ));
+    }
+    Ok(())
+}
+
+/// `intersect_preliminary` finds the hit `intersect` returned, its ids and coordinates agree
+/// with the full record, and completing it gives that record exactly.
+fn check_preliminary(scene: &TestScene, ray: &Ray<World>, hit: Option<&Hit>) -> Result<(), String> {
+    let found = scene.scene.intersect_preliminary(ray);
+    let (hit, found) = match (hit, found) {
+        (None, None) => return Ok(()),
+        (Some(hit), Some(found)) => (hit, found),
+        (hit, found) => {
+            return Err(format!(
+                "intersect() hit: {}, intersect_preliminary() hit: {} ({ray:?})",
+                hit.is_some(),
+                found.is_some()
+            ));
+        }
+    };
+    if (found.t(), found.instance(), found.primitive()) != (hit.t, hit.instance, hit.primitive) {
+        return Err(format!(
+            "preliminary t {} instance {} primitive {} against the hit's {} {} {} ({ray:?})",
+            found.t(),
+            found.instance(),
+            found.primitive(),
+            hit.t,
+            hit.instance,
+            hit.primitive
+        ));
+    }
+    if found.complete() != *hit {
+        return Err(format!(
+            "completing the preliminary hit gave another record ({ray:?})"
+        ));
+    }
+    // The coordinates: a quad's are the hit's uv, a triangle's are the barycentrics its
+    // vertex uvs are interpolated with (or the uv itself when the mesh has none).
+    let b = found.primitive_uv();
+    let expected = match &scene.instances[hit.instance as usize].0 {
+        Shape::Sphere { .. } => Vec2::ZERO,
+        Shape::Quad { .. } => hit.uv,
+        Shape::Mesh(mesh) => match mesh.uvs() {
+            None => hit.uv,
+            Some(uvs) => {
+                let [i0, i1, i2] = mesh.triangles()[hit.primitive as usize].map(|i| i as usize);
+                let (u0, u1, u2) = (uvs[i0], uvs[i1], uvs[i2]);
+                if (u0 * (1.0 - b.x - b.y) + u1 * b.x + u2 * b.y - hit.uv)
+                    .abs()
+                    .max_element()
+                    > 1e-5
+                {
+                    return Err(format!(
+                        "barycentrics {b} do not interpolate the hit's uv {} ({ray:?})",
+                        hit.uv
+                    ));
+                }
+                return Ok(());
+            }
+        },
+    };
+    if b != expected {
+        return Err(format!("primitive_uv {b}, expected {expected} ({ray:?})"));
     }
     Ok(())
 }
