@@ -187,7 +187,7 @@ def bench_accel(results):
         results["accel"].append({"mesh": f"{kind}-{size}", "obscura": ours, "embree": peer})
         n = ours["triangles"]
         print(f"\n{kind} {size}: {n:,} triangles, one thread")
-        print(f"  {'measure':<26}{'Obscura':>14}{'embreex':>14}{'ratio':>8}")
+        print(f"  {'measure':<32}{'Obscura':>14}{'embreex':>14}{'ratio':>8}")
         row(
             "build (s, lower wins)",
             ours["build_s"],
@@ -212,10 +212,10 @@ def bench_accel(results):
 
 def row(label, ours, peer, invert=False):
     if peer is None:
-        print(f"  {label:<26}{ours:>14.3f}{'-':>14}")
+        print(f"  {label:<32}{ours:>14.3f}{'-':>14}")
         return
     ratio = peer / ours if invert else ours / peer
-    print(f"  {label:<26}{ours:>14.3f}{peer:>14.3f}{ratio:>8.2f}")
+    print(f"  {label:<32}{ours:>14.3f}{peer:>14.3f}{ratio:>8.2f}")
 
 
 def bench_render(results):
@@ -365,16 +365,20 @@ def main():
     if not args.no_build:
         cargo_build()
     print(f"machine: {os.cpu_count()} CPUs, {platform_cpu()}; load {os.getloadavg()}")
-    results = {"accel": [], "render": [], "cpu": platform_cpu()}
+    # A partial run (--only) replaces its own parts of results.json and keeps the others.
+    saved = ROOT / "bench" / "results.json"
+    results = json.loads(saved.read_text()) if saved.exists() else {}
+    results["cpu"] = platform_cpu()
     if args.only in (None, "accel"):
+        results["accel"] = []
         bench_accel(results)
     if args.only in (None, "render"):
+        results["render"] = []
         bench_render(results)
     if args.only in (None, "scaling"):
-        if not results["accel"] and (ROOT / "bench" / "results.json").exists():
-            results["accel"] = json.loads((ROOT / "bench" / "results.json").read_text())["accel"]
+        results.setdefault("accel", [])
         bench_scaling(results)
-    (ROOT / "bench" / "results.json").write_text(json.dumps(results, indent=2))
+    saved.write_text(json.dumps(results, indent=2))
 
 
 def platform_cpu():

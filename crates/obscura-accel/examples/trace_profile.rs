@@ -1,6 +1,7 @@
 //! A deterministic traversal workload for instruction-count profiling (valgrind's callgrind):
 //! builds a displaced grid of 2 * 300^2 = 180,000 triangles, then traces the same 65,536
-//! coherent primary and 65,536 incoherent random rays as closest-hit and as shadow queries,
+//! coherent primary and 65,536 incoherent random rays as closest-hit (full record, then
+//! preliminary: distance and ids only) and as shadow queries,
 //! each in its own non-inlined function so `callgrind_annotate --inclusive=yes` gives per-query
 //! instruction counts.
 //!
@@ -33,6 +34,16 @@ fn closest_random(scene: &Scene, rays: &[Ray<World>]) -> f64 {
 }
 
 #[inline(never)]
+fn preliminary_primary(scene: &Scene, rays: &[Ray<World>]) -> f64 {
+    preliminary(scene, rays) + 1.0
+}
+
+#[inline(never)]
+fn preliminary_random(scene: &Scene, rays: &[Ray<World>]) -> f64 {
+    preliminary(scene, rays) + 2.0
+}
+
+#[inline(never)]
 fn shadow_primary(scene: &Scene, rays: &[Ray<World>]) -> usize {
     rays.iter().filter(|r| scene.occluded(r)).count() + 1
 }
@@ -50,6 +61,13 @@ fn setup_done(scene: &Scene) {
 
 /// (Each query function adds its own constant so the linker cannot fold them into one.)
 /// Sums t and the primitive ids so the hits cannot be optimised away and runs can be compared.
+fn preliminary(scene: &Scene, rays: &[Ray<World>]) -> f64 {
+    rays.iter()
+        .filter_map(|r| scene.intersect_preliminary(r))
+        .map(|h| f64::from(h.t()) + f64::from(h.primitive()))
+        .sum()
+}
+
 fn closest(scene: &Scene, rays: &[Ray<World>]) -> f64 {
     rays.iter()
         .filter_map(|r| scene.intersect(r))
@@ -85,6 +103,14 @@ fn main() {
     println!(
         "closest random {:.3}",
         black_box(closest_random(&scene, &random))
+    );
+    println!(
+        "preliminary primary {:.3}",
+        black_box(preliminary_primary(&scene, &primary))
+    );
+    println!(
+        "preliminary random {:.3}",
+        black_box(preliminary_random(&scene, &random))
     );
     println!(
         "shadow primary {}",
