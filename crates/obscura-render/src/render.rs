@@ -1,11 +1,15 @@
 //! The parallel tile renderer: passes of one sample per pixel over tiles, merged in order.
 //!
-//! A render is a sequence of passes; pass `k` takes sample index `k` of every pixel. Within a
-//! pass, tiles are rendered in parallel (rayon) into their own buffers, merged in tile order
-//! into a pass accumulator (one batch of tiles merging while the next batch, of this pass or
-//! the next, renders), and the pass is then added to the film pixel by pixel. The pass schedule depends only on the scene, never on threads or timing,
-//! so a render is bit-identical for any thread count, and a render stopped after pass `k` and
-//! resumed from there equals one that ran straight through.
+//! A render is a sequence of passes; pass `k` takes sample index `k` of every pixel. The
+//! (pass, tile) jobs are numbered pass by pass, and every worker takes the next job number from
+//! one counter, renders the tile into its own buffer and leaves it in a slot; whichever worker
+//! is free merges the buffers in job order into a pass accumulator, which is added to the film
+//! pixel by pixel when its pass's last tile is merged. No worker waits at a pass or batch
+//! boundary: only a window of buffers (the slowest tile in flight holds up the merge of the
+//! ones after it) bounds how far rendering runs ahead of merging. The merge order depends only
+//! on the scene, never on threads or timing, so a render is bit-identical for any thread count,
+//! and a render stopped after pass `k` and resumed from there equals one that ran straight
+//! through.
 
 use crate::build::RenderScene;
 use crate::film::{Film, PixelRect, TileBuffer};
@@ -15,7 +19,6 @@ use obscura_camera::{Camera, CameraSample};
 use obscura_sample::SampleStream;
 use obscura_shade::PathIntegrator;
 use obscura_space::{Point2, Ray, World};
-use rayon::prelude::*;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
@@ -23,8 +26,30 @@ use std::time::{Duration, Instant};
 /// Tile edge in pixels.
 pub const TILE_SIZE: u32 = 16;
 
-/// How many tiles are rendered before they are merged (bounds the memory of tile buffers).
-const TILES_PER_BATCH: usize = 256;
+/// How many rendered tiles may wait to be merged (bounds the memory of tile buffers): the
+/// slowest tile in flight holds up the merge of the ones after it.
+const TILE_WINDOW: usize = 256;
+
+/// The in-order merge of rendered tiles: the pass accumulator and the film it completes into.
+struct Merger {
+    /// The next job to merge.
+    cursor: u64,
+    /// The sums of the pass under way; added to the film when its last tile is merged, so a
+    /// pass cut short leaves the film untouched and no per-pass copy of it is needed.
+    pass_film: Film,
+    /// The film: complete passes only.
+    film: Film,
+    /// Passes in the film.
+    passes_done: u32,
+    /// Set once a cancelled render has stopped adding passes.
+    stopped: bool,
+}
+
+/// Locks `m`; a worker that panicked cannot leave a tile buffer or a slot half-written, so a
+/// poisoned lock's contents are still sound.
+fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|e| e.into_inner())
+}
 
 /// Counters of a render.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -108,102 +133,124 @@ pub fn render(
     let pool = builder.build()?;
     let start = Instant::now();
     let spp = scene.sampler.samples_per_pixel();
-    let (mut film, first_pass) = options
+    let (film, first_pass) = options
         .resume
         .unwrap_or_else(|| (Film::new(scene.pixel_bounds), 0));
     let tiles = tiles(scene.pixel_bounds);
     let total_tiles = tiles.len() as u64 * u64::from(spp.saturating_sub(first_pass));
+    let jobs = total_tiles;
     let tiles_done = AtomicU64::new(0);
     let samples = AtomicU64::new(0);
     let dropped = AtomicU64::new(0);
     let no_ray = AtomicU64::new(0);
     let cancelled = || options.cancel.is_some_and(|c| c.load(Ordering::Relaxed));
-    let mut passes_done = first_pass;
     let path = PathIntegrator::new(scene.description.integrator.max_depth);
 
     let on_pass = options.on_pass;
-    let batches: Vec<&[PixelRect]> = tiles.chunks(TILES_PER_BATCH).collect();
-    if batches.is_empty() {
-        passes_done = spp;
-    }
-    pool.install(|| {
-        // A pass's samples are summed here, then added to the film pixel by pixel, so a pass
-        // cut short leaves the film untouched and no per-pass copy of it is needed.
-        let mut pass_film = Film::new(scene.pixel_bounds);
-        // Rendered tile buffers not yet merged, with their pass and whether they close it.
-        // They are merged (in tile order, on one thread) while the next batch renders on the
-        // others, across pass boundaries too: the next pass's first batch is only merged once
-        // this pass has been added to the film and the accumulator cleared.
-        let mut pending: Option<(u32, Vec<TileBuffer>, bool)> = None;
-        let spare: Mutex<Vec<TileBuffer>> = Mutex::new(Vec::new());
-        let settle = |pending: Option<(u32, Vec<TileBuffer>, bool)>,
-                      pass_film: &mut Film,
-                      film: &mut Film,
-                      passes_done: &mut u32| {
-            let Some((pass, buffers, closes_pass)) = pending else {
+    let window = TILE_WINDOW.max(4 * pool.current_num_threads());
+    // Job j is tile j % tiles of pass first_pass + j / tiles: workers take jobs in this order
+    // from one counter, and the rendered buffers are merged in the same order through a
+    // window of slots, so the film never depends on which worker rendered what.
+    let next_job = AtomicU64::new(0);
+    // The merger's cursor, readable without its lock.
+    let merged = AtomicU64::new(0);
+    let slots: Vec<Mutex<Option<TileBuffer>>> = (0..window).map(|_| Mutex::new(None)).collect();
+    let spare: Mutex<Vec<TileBuffer>> = Mutex::new(Vec::new());
+    let merger = Mutex::new(Merger {
+        cursor: 0,
+        pass_film: Film::new(scene.pixel_bounds),
+        film,
+        passes_done: first_pass,
+        stopped: false,
+    });
+    let tile_count = tiles.len() as u64;
+    // Merges every rendered job from the cursor on, in order; a finished pass goes to the film
+    // (unless the render was cancelled: then nothing more is added).
+    let merge_ready = |m: &mut Merger| {
+        while m.cursor < jobs && !m.stopped {
+            let Some(buffer) = lock(&slots[(m.cursor % window as u64) as usize]).take() else {
                 return;
             };
-            for b in &buffers {
-                pass_film.merge(b);
-            }
-            // Merged buffers go back for reuse: no allocation, and no fresh pages to fault in,
-            // per tile and pass.
-            if let Ok(mut s) = spare.lock() {
-                s.extend(buffers);
-            }
-            if closes_pass {
-                film.add(pass_film);
-                pass_film.clear();
-                *passes_done = pass + 1;
+            m.pass_film.merge(&buffer);
+            lock(&spare).push(buffer);
+            m.cursor += 1;
+            merged.store(m.cursor, Ordering::Release);
+            if m.cursor.is_multiple_of(tile_count) {
+                if cancelled() {
+                    m.stopped = true;
+                    return;
+                }
+                let pass = first_pass + (m.cursor / tile_count) as u32;
+                m.film.add(&m.pass_film);
+                m.pass_film.clear();
+                m.passes_done = pass;
                 if let Some(f) = on_pass {
-                    f(pass + 1, spp, film);
+                    f(pass, spp, &m.film);
                 }
-            }
-        };
-        'passes: for pass in first_pass..spp {
-            for (i, batch) in batches.iter().enumerate() {
-                let previous = pending.take();
-                let (buffers, ()) = rayon::join(
-                    || {
-                        batch
-                            .par_iter()
-                            .map(|&tile| {
-                                if cancelled() {
-                                    return None;
-                                }
-                                let recycled = spare.lock().ok().and_then(|mut s| s.pop());
-                                let mut buffer = match recycled {
-                                    Some(mut b) => {
-                                        b.reset(tile, scene.pixel_bounds);
-                                        b
-                                    }
-                                    None => TileBuffer::new(tile, scene.pixel_bounds, scene.filter),
-                                };
-                                let counts = render_tile(scene, &path, tile, pass, &mut buffer);
-                                samples.fetch_add(counts.samples, Ordering::Relaxed);
-                                dropped.fetch_add(counts.dropped_nonfinite, Ordering::Relaxed);
-                                no_ray.fetch_add(counts.no_ray, Ordering::Relaxed);
-                                let done = tiles_done.fetch_add(1, Ordering::Relaxed) + 1;
-                                if let Some(f) = options.on_tile {
-                                    f(done, total_tiles);
-                                }
-                                Some(buffer)
-                            })
-                            .collect::<Vec<Option<TileBuffer>>>()
-                    },
-                    || settle(previous, &mut pass_film, &mut film, &mut passes_done),
-                );
-                if cancelled() || buffers.iter().any(Option::is_none) {
-                    // Cancelled: the pass under way is dropped (the one before it, if it was
-                    // still pending, was added to the film by the settle just done).
-                    break 'passes;
-                }
-                let closes_pass = i + 1 == batches.len();
-                pending = Some((pass, buffers.into_iter().flatten().collect(), closes_pass));
             }
         }
-        settle(pending.take(), &mut pass_film, &mut film, &mut passes_done);
-    });
+    };
+    let worker = || {
+        loop {
+            if cancelled() {
+                return;
+            }
+            let job = next_job.fetch_add(1, Ordering::Relaxed);
+            if job >= jobs {
+                return;
+            }
+            // The job's slot is free once the merge is within a window of it. The job at the
+            // merge cursor is being rendered by another worker, so this wait is short (and
+            // rare); meanwhile merge whatever is ready.
+            while job >= merged.load(Ordering::Acquire) + window as u64 {
+                if let Ok(mut m) = merger.try_lock() {
+                    merge_ready(&mut m);
+                    if m.stopped {
+                        return;
+                    }
+                }
+                if cancelled() {
+                    return;
+                }
+                std::thread::yield_now();
+            }
+            let tile = tiles[(job % tile_count) as usize];
+            let pass = first_pass + (job / tile_count) as u32;
+            let mut buffer = match lock(&spare).pop() {
+                Some(mut b) => {
+                    b.reset(tile, scene.pixel_bounds);
+                    b
+                }
+                None => TileBuffer::new(tile, scene.pixel_bounds, scene.filter),
+            };
+            let counts = render_tile(scene, &path, tile, pass, &mut buffer);
+            samples.fetch_add(counts.samples, Ordering::Relaxed);
+            dropped.fetch_add(counts.dropped_nonfinite, Ordering::Relaxed);
+            no_ray.fetch_add(counts.no_ray, Ordering::Relaxed);
+            let done = tiles_done.fetch_add(1, Ordering::Relaxed) + 1;
+            if let Some(f) = options.on_tile {
+                f(done, total_tiles);
+            }
+            *lock(&slots[(job % window as u64) as usize]) = Some(buffer);
+            // Merge if no one else is (a worker that holds the merger merges what is ready
+            // when it looks next; the last merges happen after the workers stop).
+            if let Ok(mut m) = merger.try_lock() {
+                merge_ready(&mut m);
+            }
+        }
+    };
+    if jobs > 0 {
+        pool.broadcast(|_| worker());
+    }
+    // What the workers left unmerged: every job taken was rendered, so this completes every
+    // pass that was not cut short.
+    let mut m = merger.into_inner().unwrap_or_else(|e| e.into_inner());
+    merge_ready(&mut m);
+    let (film, passes_done) = if tiles.is_empty() {
+        (m.film, spp)
+    } else {
+        (m.film, m.passes_done)
+    };
     Ok(RenderOutcome {
         film,
         passes_done,
