@@ -1,10 +1,15 @@
-//! The shipped scenes, rendered small, checked against geometry worked out by hand.
+//! The shipped scenes, rendered small, checked against geometry worked out by hand, and the
+//! renderer's determinism across thread counts and cancellation.
 
 use super::{aov, render_image, shipped};
 use glam::Vec3;
 use obscura_camera::Camera;
-use obscura_render::{FilterSettings, Image, IntegratorKind, RenderScene};
+use obscura_render::{
+    Film, FilterSettings, Image, IntegratorKind, RenderOptions, RenderOutcome, RenderScene,
+    SceneDescription, TILE_WINDOW, render, tiles,
+};
 use obscura_space::{Point3, World};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 /// Every shipped scene loads, builds and renders a tiny image with finite pixels.
 #[test]
@@ -324,6 +329,102 @@ fn images_are_identical_for_one_and_two_threads() {
             .zip(&two.pixels)
             .all(|(a, b)| a.map(f32::to_bits) == b.map(f32::to_bits))
     );
+}
+
+/// Renders `d` on `threads` workers; when pass `hold_pass` is complete, the pass callback
+/// (which runs while the merge is held) waits until `hold_until(total tiles)` tiles have been
+/// rendered, then sets the cancel flag if `cancel_after_hold`. So the other workers run ahead
+/// of the merge by a known amount, with no timing involved.
+fn render_holding_the_merge(
+    d: SceneDescription,
+    threads: usize,
+    hold_pass: u32,
+    hold_until: impl Fn(u64) -> u64 + Sync,
+    cancel_after_hold: bool,
+) -> RenderOutcome {
+    let scene = RenderScene::build(d).unwrap();
+    let cancel = AtomicBool::new(false);
+    let rendered = AtomicU64::new(0);
+    let total = AtomicU64::new(u64::MAX);
+    let on_tile = |done: u64, all: u64| {
+        total.store(all, Ordering::SeqCst);
+        rendered.fetch_max(done, Ordering::SeqCst);
+    };
+    let on_pass = |passes: u32, _: u32, _: &Film| {
+        if passes == hold_pass {
+            let target = hold_until(total.load(Ordering::SeqCst));
+            while rendered.load(Ordering::SeqCst) < target {
+                std::thread::yield_now();
+            }
+            if cancel_after_hold {
+                cancel.store(true, Ordering::SeqCst);
+            }
+        }
+    };
+    render(
+        &scene,
+        RenderOptions {
+            threads: Some(threads),
+            cancel: Some(&cancel),
+            on_pass: Some(&on_pass),
+            on_tile: Some(&on_tile),
+            ..RenderOptions::default()
+        },
+    )
+    .unwrap()
+}
+
+#[test]
+fn images_are_identical_for_any_thread_count_when_rendering_runs_far_ahead_of_merging() {
+    // 25 x 23 = 575 tiles a pass, three passes. The merge is held after the first pass until
+    // the other workers have rendered a whole window of tiles past it, so they must wait for
+    // the merge; the Gaussian filter makes neighbouring tiles overlap, so the merge order
+    // shows in the bits of the film.
+    let d = aov(
+        shipped("spheres-perspective.toml"),
+        IntegratorKind::Path,
+        [400, 360],
+        3,
+    );
+    let per_pass = tiles(RenderScene::build(d.clone()).unwrap().pixel_bounds).len() as u64;
+    assert_eq!(per_pass, 575);
+    let one = render_image(d.clone(), 1);
+    let held = render_holding_the_merge(d, 3, 1, |_| per_pass + TILE_WINDOW as u64, false);
+    assert_eq!(held.passes_done, 3);
+    let three = held.film.resolve();
+    assert_eq!(one.pixels.len(), three.pixels.len());
+    assert!(
+        one.pixels
+            .iter()
+            .zip(&three.pixels)
+            .all(|(a, b)| a.map(f32::to_bits) == b.map(f32::to_bits))
+    );
+}
+
+#[test]
+fn a_cancelled_render_on_several_threads_keeps_exactly_the_passes_before_the_cancel() {
+    // Every tile of all five passes is rendered while the merge is held at pass 2; the
+    // cancel then comes, so passes 3-5, although rendered, must not reach the film.
+    let d = aov(
+        shipped("spheres-perspective.toml"),
+        IntegratorKind::Path,
+        [96, 64],
+        5,
+    );
+    let outcome = render_holding_the_merge(d.clone(), 3, 2, |total| total, true);
+    assert_eq!(outcome.passes_done, 2);
+    let mut two = d;
+    two.sampler.spp = 2;
+    let straight = render(
+        &RenderScene::build(two).unwrap(),
+        RenderOptions {
+            threads: Some(1),
+            ..RenderOptions::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(straight.passes_done, 2);
+    assert!(outcome.film == straight.film, "the films differ");
 }
 
 #[test]

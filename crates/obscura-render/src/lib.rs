@@ -69,6 +69,6 @@ pub use postprocess::{
     depth_of_field, motion_blur, screen_buffers,
 };
 pub use render::{
-    RenderOptions, RenderOutcome, RenderStats, TILE_SIZE, render, sample_value, tiles,
+    RenderOptions, RenderOutcome, RenderStats, TILE_SIZE, TILE_WINDOW, render, sample_value, tiles,
 };
 pub use scene::*;

@@ -27,8 +27,9 @@ use std::time::{Duration, Instant};
 pub const TILE_SIZE: u32 = 16;
 
 /// How many rendered tiles may wait to be merged (bounds the memory of tile buffers): the
-/// slowest tile in flight holds up the merge of the ones after it.
-const TILE_WINDOW: usize = 256;
+/// slowest tile in flight holds up the merge of the ones after it, and a worker does not start
+/// a tile this many jobs past the merge.
+pub const TILE_WINDOW: usize = 256;
 
 /// The in-order merge of rendered tiles: the pass accumulator and the film it completes into.
 struct Merger {
@@ -147,7 +148,7 @@ pub fn render(
     let path = PathIntegrator::new(scene.description.integrator.max_depth);
 
     let on_pass = options.on_pass;
-    let window = TILE_WINDOW.max(4 * pool.current_num_threads());
+    let window = TILE_WINDOW;
     // Job j is tile j % tiles of pass first_pass + j / tiles: workers take jobs in this order
     // from one counter, and the rendered buffers are merged in the same order through a
     // window of slots, so the film never depends on which worker rendered what.
