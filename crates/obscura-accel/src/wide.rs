@@ -196,23 +196,26 @@ impl Prepared {
     /// `[t_min, t_max]`.
     #[inline(always)]
     fn boxes(&self, node: &Node, t_min: f32, t_max: f32) -> ([Vec4; 2], u32) {
+        let (near_lo, mask_lo) = self.half(node, 0, t_min, t_max);
+        let (near_hi, mask_hi) = self.half(node, 1, t_min, t_max);
+        ([near_lo, near_hi], mask_lo | (mask_hi << 4))
+    }
+
+    /// [`Prepared::boxes`] for children `4h..4h + 4` only.
+    #[inline(always)]
+    fn half(&self, node: &Node, h: usize, t_min: f32, t_max: f32) -> (Vec4, u32) {
         let b = &node.bounds;
         let (nx, ny, nz) = (self.near[0] & 1, self.near[1] & 1, self.near[2] & 1);
-        let half = |h: usize| {
-            let tnx = (b[nx][h] - self.o[0]) * self.inv[0];
-            let tfx = (b[nx ^ 1][h] - self.o[0]) * self.inv[0];
-            let tny = (b[2 + ny][h] - self.o[1]) * self.inv[1];
-            let tfy = (b[2 + (ny ^ 1)][h] - self.o[1]) * self.inv[1];
-            let tnz = (b[4 + nz][h] - self.o[2]) * self.inv[2];
-            let tfz = (b[4 + (nz ^ 1)][h] - self.o[2]) * self.inv[2];
-            let t_near = tnx.max(tny).max(tnz.max(Vec4::splat(t_min)));
-            let t_far = tfx.min(tfy).min(tfz);
-            let t_far = (t_far + t_far.abs() * SLAB_SLACK).min(Vec4::splat(t_max));
-            (t_near, t_near.cmple(t_far).bitmask())
-        };
-        let (near_lo, mask_lo) = half(0);
-        let (near_hi, mask_hi) = half(1);
-        ([near_lo, near_hi], mask_lo | (mask_hi << 4))
+        let tnx = (b[nx][h] - self.o[0]) * self.inv[0];
+        let tfx = (b[nx ^ 1][h] - self.o[0]) * self.inv[0];
+        let tny = (b[2 + ny][h] - self.o[1]) * self.inv[1];
+        let tfy = (b[2 + (ny ^ 1)][h] - self.o[1]) * self.inv[1];
+        let tnz = (b[4 + nz][h] - self.o[2]) * self.inv[2];
+        let tfz = (b[4 + (nz ^ 1)][h] - self.o[2]) * self.inv[2];
+        let t_near = tnx.max(tny).max(tnz.max(Vec4::splat(t_min)));
+        let t_far = tfx.min(tfy).min(tfz);
+        let t_far = (t_far + t_far.abs() * SLAB_SLACK).min(Vec4::splat(t_max));
+        (t_near, t_near.cmple(t_far).bitmask())
     }
 
     /// The lanes of `p` the ray hits within `[t_min, t_max]`, with their distances and
@@ -468,8 +471,21 @@ impl BoxSet {
     /// The mask of the boxes the ray enters within `[t_min, t_max]` (bit `i` for box `i`).
     #[inline]
     pub(crate) fn entered_mask(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> u32 {
-        let (_, mask) = Prepared::new(o, d).boxes(&self.node, t_min, t_max);
-        mask & ((1u32 << self.len) - 1)
+        self.test(o, d, t_min, t_max).1
+    }
+
+    /// The entry distances and the mask of the boxes entered; four boxes or fewer take one
+    /// register's worth of tests, not two.
+    #[inline(always)]
+    fn test(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> ([Vec4; 2], u32) {
+        let ray = Prepared::new(o, d);
+        let (t_near, mask) = if self.len <= WIDTH {
+            let (near_lo, mask_lo) = ray.half(&self.node, 0, t_min, t_max);
+            ([near_lo, Vec4::INFINITY], mask_lo)
+        } else {
+            ray.boxes(&self.node, t_min, t_max)
+        };
+        (t_near, mask & ((1u32 << self.len) - 1))
     }
 
     /// The boxes the ray enters within `[t_min, t_max]`, as (index, entry distance), nearest
@@ -483,8 +499,8 @@ impl BoxSet {
         t_max: f32,
         out: &mut [(usize, f32); ARITY],
     ) -> usize {
-        let (t_near, mask) = Prepared::new(o, d).boxes(&self.node, t_min, t_max);
-        by_entry(mask & ((1u32 << self.len) - 1), t_near, |lane| lane, out)
+        let (t_near, mask) = self.test(o, d, t_min, t_max);
+        by_entry(mask, t_near, |lane| lane, out)
     }
 }
 
