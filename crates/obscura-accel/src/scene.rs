@@ -623,9 +623,8 @@ impl Scene {
     /// The closest hit on any item, before its record is built.
     #[inline]
     fn found(&self, r: &PlainRay) -> Option<Found> {
-        let r = *r;
         match &self.tlas {
-            Top::One if self.items.len() == 1 => self.intersect_item(0, &r, r.t_max),
+            Top::One if self.items.len() == 1 => self.intersect_item(0, r, r.t_max),
             Top::One => None,
             Top::Few(set) => {
                 let mut entered = [(0, 0.0); BoxSet::CAPACITY];
@@ -636,7 +635,7 @@ impl Scene {
                     if t_entry > t_max {
                         break;
                     }
-                    if let Some(f) = self.intersect_item(item, &r, t_max) {
+                    if let Some(f) = self.intersect_item(item, r, t_max) {
                         best = Some(f);
                     }
                 }
@@ -647,7 +646,7 @@ impl Scene {
                 let mut ray_hit = RayHit::none();
                 let mut best = None;
                 tlas.ray_traverse(top, &mut ray_hit, |top, slot| {
-                    match self.intersect_item(order[slot] as usize, &r, top.tmax) {
+                    match self.intersect_item(order[slot] as usize, r, top.tmax) {
                         Some(f) => {
                             best = Some(f);
                             f.t()

@@ -138,8 +138,11 @@ pub fn render(
         .resume
         .unwrap_or_else(|| (Film::new(scene.pixel_bounds), 0));
     let tiles = tiles(scene.pixel_bounds);
-    let total_tiles = tiles.len() as u64 * u64::from(spp.saturating_sub(first_pass));
-    let jobs = total_tiles;
+    // Job j is tile j % tile_count of pass first_pass + j / tile_count: workers take jobs in
+    // this order from one counter, and the rendered buffers are merged in the same order
+    // through a window of slots, so the film never depends on which worker rendered what.
+    let tile_count = tiles.len() as u64;
+    let jobs = tile_count * u64::from(spp.saturating_sub(first_pass));
     let tiles_done = AtomicU64::new(0);
     let samples = AtomicU64::new(0);
     let dropped = AtomicU64::new(0);
@@ -148,14 +151,12 @@ pub fn render(
     let path = PathIntegrator::new(scene.description.integrator.max_depth);
 
     let on_pass = options.on_pass;
-    let window = TILE_WINDOW;
-    // Job j is tile j % tiles of pass first_pass + j / tiles: workers take jobs in this order
-    // from one counter, and the rendered buffers are merged in the same order through a
-    // window of slots, so the film never depends on which worker rendered what.
+    let window = TILE_WINDOW as u64;
     let next_job = AtomicU64::new(0);
     // The merger's cursor, readable without its lock.
     let merged = AtomicU64::new(0);
-    let slots: Vec<Mutex<Option<TileBuffer>>> = (0..window).map(|_| Mutex::new(None)).collect();
+    let slots: Vec<Mutex<Option<TileBuffer>>> =
+        (0..TILE_WINDOW).map(|_| Mutex::new(None)).collect();
     let spare: Mutex<Vec<TileBuffer>> = Mutex::new(Vec::new());
     let merger = Mutex::new(Merger {
         cursor: 0,
@@ -164,12 +165,11 @@ pub fn render(
         passes_done: first_pass,
         stopped: false,
     });
-    let tile_count = tiles.len() as u64;
     // Merges every rendered job from the cursor on, in order; a finished pass goes to the film
     // (unless the render was cancelled: then nothing more is added).
     let merge_ready = |m: &mut Merger| {
         while m.cursor < jobs && !m.stopped {
-            let Some(buffer) = lock(&slots[(m.cursor % window as u64) as usize]).take() else {
+            let Some(buffer) = lock(&slots[(m.cursor % window) as usize]).take() else {
                 return;
             };
             m.pass_film.merge(&buffer);
@@ -203,7 +203,7 @@ pub fn render(
             // The job's slot is free once the merge is within a window of it. The job at the
             // merge cursor is being rendered by another worker, so this wait is short (and
             // rare); meanwhile merge whatever is ready.
-            while job >= merged.load(Ordering::Acquire) + window as u64 {
+            while job >= merged.load(Ordering::Acquire) + window {
                 if let Ok(mut m) = merger.try_lock() {
                     merge_ready(&mut m);
                     if m.stopped {
@@ -230,9 +230,9 @@ pub fn render(
             no_ray.fetch_add(counts.no_ray, Ordering::Relaxed);
             let done = tiles_done.fetch_add(1, Ordering::Relaxed) + 1;
             if let Some(f) = options.on_tile {
-                f(done, total_tiles);
+                f(done, jobs);
             }
-            *lock(&slots[(job % window as u64) as usize]) = Some(buffer);
+            *lock(&slots[(job % window) as usize]) = Some(buffer);
             // Merge if no one else is (a worker that holds the merger merges what is ready
             // when it looks next; the last merges happen after the workers stop).
             if let Ok(mut m) = merger.try_lock() {
