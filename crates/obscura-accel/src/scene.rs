@@ -578,6 +578,8 @@ impl Scene {
     /// The same as [`intersect_preliminary`](Scene::intersect_preliminary) followed by
     /// [`PreliminaryHit::complete`].
     pub fn intersect(&self, ray: &Ray<World>) -> Option<Hit> {
+        // Written out rather than as `intersect_preliminary(ray)?.complete()`: moving the
+        // `PreliminaryHit` through costs 1% of a render's instructions (callgrind).
         let r = PlainRay::new(ray)?;
         let found = self.found(&r)?;
         Some(self.finish(&r, found))
