@@ -56,6 +56,7 @@ mod geom;
 mod hit;
 mod mesh;
 mod obj;
+mod pages;
 mod scene;
 pub mod testmesh;
 mod wide;

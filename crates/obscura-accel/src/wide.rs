@@ -20,6 +20,7 @@
 //! Everything is safe Rust: the lanes are glam's `Vec4`, which is an SSE register on x86-64.
 
 use crate::geom::TriangleHit;
+use crate::pages::Pages;
 use glam::{BVec4A, Vec3, Vec3A, Vec4};
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
@@ -93,15 +94,17 @@ const WIDTH: usize = 4;
 const SLAB_SLACK: f32 = 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
 
 /// Eight children's boxes, one lane per child (children 0-3 in the first register, 4-7 in
-/// the second), and what each child is: 224 bytes, aligned to start a cache line so a node
-/// costs four lines, never five.
-#[derive(Clone, Copy, Debug)]
+/// the second), and what each child is: 224 bytes, padded to the four cache lines it would
+/// take anyway, and aligned to start a line so it never takes five.
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 #[repr(C, align(64))]
 struct Node {
     /// `[min_x, max_x, min_y, max_y, min_z, max_z]`; an unused lane has min +inf, max -inf.
     bounds: [[Vec4; 2]; 6],
     /// A node index, `LEAF | packet index`, or `EMPTY`.
     child: [u32; ARITY],
+    /// Explicit padding to 256 bytes, so a node is plain bytes ([`Pages`] maps it).
+    _pad: [u32; 8],
 }
 
 impl Node {
@@ -116,6 +119,7 @@ impl Node {
             [Vec4::NEG_INFINITY; 2],
         ],
         child: [EMPTY; ARITY],
+        _pad: [0; 8],
     };
 
     /// Puts `aabb` in lane `lane`.
@@ -127,8 +131,9 @@ impl Node {
     }
 }
 
-/// Up to four triangles, one lane each: the first vertex and the two edges from it.
-#[derive(Clone, Copy, Debug)]
+/// Up to four triangles, one lane each: the first vertex and the two edges from it; 176
+/// bytes padded to three cache lines.
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 #[repr(C, align(64))]
 struct Packet {
     v0: [Vec4; 3],
@@ -137,6 +142,8 @@ struct Packet {
     /// The caller's two ids of the triangle in each lane (padding lanes are degenerate and
     /// never hit): a hit is reported without touching any other array.
     ids: [[u32; WIDTH]; 2],
+    /// Explicit padding to 192 bytes, so a packet is plain bytes ([`Pages`] maps it).
+    _pad: [u32; 4],
 }
 
 /// A hit found by [`WideBvh::closest`]: the triangle's ids and the triangle itself as the BVH
@@ -153,11 +160,12 @@ pub(crate) struct WideHit {
     pub e2: Vec3,
 }
 
-/// An eight-wide BVH with four-wide leaf packets over a list of triangles.
+/// An eight-wide BVH with four-wide leaf packets over a list of triangles, its arrays on huge
+/// pages where they are large enough ([`Pages`]).
 #[derive(Clone, Debug)]
 pub(crate) struct WideBvh {
-    nodes: Vec<Node>,
-    packets: Vec<Packet>,
+    nodes: Pages<Node>,
+    packets: Pages<Packet>,
     /// A node index, a leaf reference, or `EMPTY` for no triangles.
     root: u32,
 }
@@ -262,22 +270,23 @@ impl WideBvh {
         debug_assert_eq!(tris.len(), ids.len());
         if tris.is_empty() {
             return WideBvh {
-                nodes: Vec::new(),
-                packets: Vec::new(),
+                nodes: Pages::new(Vec::new()),
+                packets: Pages::new(Vec::new()),
                 root: EMPTY,
             };
         }
         let bvh2 = build_bvh2(tris, params);
-        let mut bvh = WideBvh {
-            nodes: Vec::new(),
-            packets: Vec::new(),
-            root: EMPTY,
-        };
-        Collapse::new(&bvh2, tris, ids).run(&mut bvh);
-        // The vectors grew by doubling; a scene keeps them for its lifetime.
-        bvh.nodes.shrink_to_fit();
-        bvh.packets.shrink_to_fit();
-        bvh
+        let mut arrays = Arrays::default();
+        let root = Collapse::new(&bvh2, tris, ids).run(&mut arrays);
+        drop(bvh2);
+        // Into their final home one at a time, each vector freed as soon as it is copied.
+        let nodes = Pages::new(arrays.nodes);
+        let packets = Pages::new(arrays.packets);
+        WideBvh {
+            nodes,
+            packets,
+            root,
+        }
     }
 
     /// The closest triangle hit with `t` in `[t_min, t_max]`.
@@ -306,6 +315,7 @@ impl WideBvh {
         t_max: f32,
     ) -> Option<WideHit> {
         let ray = Prepared::new(o, d);
+        let (nodes, packets) = (&*self.nodes, &*self.packets);
         // The packet and lane of the best hit so far, with the hit.
         let mut best: Option<(usize, usize, TriangleHit)> = None;
         let mut warm = 0u32;
@@ -313,7 +323,7 @@ impl WideBvh {
         let mut current = self.root;
         loop {
             if current & LEAF == 0 {
-                let node = &self.nodes[current as usize];
+                let node = &nodes[current as usize];
                 let (t_near, mask) = ray.boxes(node, t_min, t_best);
                 if mask != 0 {
                     if mask & (mask - 1) == 0 {
@@ -324,7 +334,7 @@ impl WideBvh {
                     let mut hits = [(0u32, 0f32); ARITY];
                     let n = by_entry(mask, t_near, |lane| node.child[lane], &mut hits);
                     for &entry in hits[1..n].iter().rev() {
-                        warm ^= self.touch(entry.0);
+                        warm ^= touch(nodes, packets, entry.0);
                         stack.push(entry);
                     }
                     current = hits[0].0;
@@ -332,7 +342,7 @@ impl WideBvh {
                 }
             } else if current != EMPTY {
                 let index = (current & !LEAF) as usize;
-                let packet = &self.packets[index];
+                let packet = &packets[index];
                 let (mask, t, b1, b2) = ray.triangles(packet, t_min, t_best);
                 if mask != 0 {
                     let (t, b1, b2) = (t.to_array(), b1.to_array(), b2.to_array());
@@ -372,25 +382,26 @@ impl WideBvh {
     #[inline(always)]
     fn any_with(&self, stack: &mut Vec<u32>, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> bool {
         let ray = Prepared::new(o, d);
+        let (nodes, packets) = (&*self.nodes, &*self.packets);
         let mut warm = 0u32;
         let mut current = self.root;
         loop {
             if current & LEAF == 0 {
-                let node = &self.nodes[current as usize];
+                let node = &nodes[current as usize];
                 let (_, mut mask) = ray.boxes(node, t_min, t_max);
                 if mask != 0 {
                     current = node.child[mask.trailing_zeros() as usize & 7];
                     mask &= mask - 1;
                     while mask != 0 {
                         let child = node.child[mask.trailing_zeros() as usize & 7];
-                        warm ^= self.touch(child);
+                        warm ^= touch(nodes, packets, child);
                         stack.push(child);
                         mask &= mask - 1;
                     }
                     continue;
                 }
             } else if current != EMPTY {
-                let packet = &self.packets[(current & !LEAF) as usize];
+                let packet = &packets[(current & !LEAF) as usize];
                 if ray.triangles(packet, t_min, t_max).0 != 0 {
                     std::hint::black_box(warm);
                     return true;
@@ -401,23 +412,6 @@ impl WideBvh {
                 return false;
             };
             current = next;
-        }
-    }
-
-    /// Reads one word of each cache line of a stacked child, so its lines are on their way
-    /// while the nearer child is traversed (safe Rust has no prefetch instruction; loads that
-    /// nothing waits on do the same).
-    #[inline(always)]
-    fn touch(&self, r: u32) -> u32 {
-        if r & LEAF == 0 {
-            self.nodes.get(r as usize).map_or(0, |n| {
-                let b = &n.bounds;
-                b[0][0].x.to_bits() ^ b[2][0].y.to_bits() ^ b[4][0].z.to_bits() ^ n.child[0]
-            })
-        } else {
-            self.packets.get((r & !LEAF) as usize).map_or(0, |p| {
-                p.v0[0].x.to_bits() ^ p.e1[1].y.to_bits() ^ p.e2[2].z.to_bits()
-            })
         }
     }
 
@@ -436,7 +430,24 @@ impl WideBvh {
 
     /// Bytes held by the nodes and packets (for the memory figures).
     pub(crate) fn heap_bytes(&self) -> usize {
-        self.nodes.capacity() * size_of::<Node>() + self.packets.capacity() * size_of::<Packet>()
+        self.nodes.bytes() + self.packets.bytes()
+    }
+}
+
+/// Reads one word of each cache line of a stacked child, so its lines are on their way
+/// while the nearer child is traversed (safe Rust has no prefetch instruction; loads that
+/// nothing waits on do the same).
+#[inline(always)]
+fn touch(nodes: &[Node], packets: &[Packet], r: u32) -> u32 {
+    if r & LEAF == 0 {
+        nodes.get(r as usize).map_or(0, |n| {
+            let b = &n.bounds;
+            b[0][0].x.to_bits() ^ b[2][0].y.to_bits() ^ b[4][0].z.to_bits() ^ n.child[0]
+        })
+    } else {
+        packets.get((r & !LEAF) as usize).map_or(0, |p| {
+            p.v0[0].x.to_bits() ^ p.e1[1].y.to_bits() ^ p.e2[2].z.to_bits()
+        })
     }
 }
 
@@ -537,6 +548,13 @@ fn build_bvh2(tris: &[[Vec3A; 3]], params: BvhBuildParams) -> Bvh2 {
     };
     ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
     bvh2
+}
+
+/// The nodes and packets of a [`WideBvh`] as the collapse makes them.
+#[derive(Default)]
+struct Arrays {
+    nodes: Vec<Node>,
+    packets: Vec<Packet>,
 }
 
 /// The collapse of a binary BVH into [`WideBvh`] nodes and packets.
@@ -662,10 +680,11 @@ impl<'a> Collapse<'a> {
         }
     }
 
-    fn run(&self, out: &mut WideBvh) {
+    /// Fills `out` and returns the root's reference.
+    fn run(&self, out: &mut Arrays) -> u32 {
         // Work list of (binary node, its wide node).
         let mut work = Vec::new();
-        out.root = self.reference(0, out, &mut work);
+        let root = self.reference(0, out, &mut work);
         while let Some((b2, wide)) = work.pop() {
             let kids = self.open(b2);
             let mut node = Node::EMPTY;
@@ -681,11 +700,12 @@ impl<'a> Collapse<'a> {
             work[first_new..].reverse();
             out.nodes[wide as usize] = node;
         }
+        root
     }
 
     /// The reference a wide node stores for binary node `b2`: a packet for a small subtree,
     /// else a fresh wide node queued for filling.
-    fn reference(&self, b2: u32, out: &mut WideBvh, work: &mut Vec<(u32, u32)>) -> u32 {
+    fn reference(&self, b2: u32, out: &mut Arrays, work: &mut Vec<(u32, u32)>) -> u32 {
         if self.choice[b2 as usize][0] == 0 {
             let packet = self.packet(b2);
             out.packets.push(packet);
@@ -715,6 +735,7 @@ impl<'a> Collapse<'a> {
             e1: [Vec4::ZERO; 3],
             e2: [Vec4::ZERO; 3],
             ids: [[EMPTY; WIDTH]; 2],
+            _pad: [0; 4],
         };
         let mut lane = 0;
         let mut pending = vec![b2];
@@ -846,6 +867,27 @@ mod tests {
             assert_eq!(lanes > tris.len(), params.pre_split, "{lanes} lanes");
             check_against_every_triangle(&tris, &bvh);
         }
+    }
+
+    /// A tree large enough for its arrays to move to huge pages answers exactly as testing
+    /// every triangle does, and so does its clone.
+    #[test]
+    fn a_tree_on_huge_pages_answers_the_same() {
+        let tris: Vec<[Vec3A; 3]> = soup(40_000, 11)
+            .into_iter()
+            .map(|[a, b, c]| [a, a + (b - a) * 0.1, a + (c - a) * 0.1])
+            .collect();
+        let ids = (0..tris.len() as u32).map(|i| [i, 7]).collect::<Vec<_>>();
+        let bvh = WideBvh::build(&tris, &ids, BvhBuildParams::fast_build());
+        if cfg!(target_os = "linux") {
+            assert!(
+                bvh.packets.is_mapped(),
+                "{} bytes of packets",
+                bvh.packets.bytes()
+            );
+        }
+        check_against_every_triangle(&tris, &bvh);
+        check_against_every_triangle(&tris, &bvh.clone());
     }
 
     fn check_against_every_triangle(tris: &[[Vec3A; 3]], bvh: &WideBvh) {
