@@ -1,12 +1,14 @@
 //! Large read-only arrays kept on transparent huge pages.
 //!
 //! A ray through a BVH over a million triangles visits about ten nodes and leaf packets spread
-//! over 100 MB. With 4 KiB pages, nearly every one of those visits also misses the TLB, and on
-//! a virtual machine the page walk that follows costs about as much as the cache miss itself.
+//! over 120 MB. With 4 KiB pages, nearly every one of those visits also misses the TLB, and on
+//! a virtual machine the page walk that follows is itself a chain of memory reads (nested
+//! paging).
 //! Linux backs memory with 2 MiB pages where the mapping asks for them (`madvise` with
 //! `MADV_HUGEPAGE`; Embree asks for its BVH too), but the allocator behind `Vec` does not ask.
-//! [`Pages`] moves a finished array into an anonymous mapping that does: on a 1.31M-triangle
-//! mesh that is 20% more incoherent rays per second (docs/performance.md, round 4).
+//! [`Pages`] moves a finished array into an anonymous mapping that does: on the 1M-triangle
+//! benchmark meshes that is 6-26% more incoherent rays per second (docs/performance.md,
+//! round 4).
 //!
 //! Arrays under [`Pages::MIN_BYTES`], and every array on systems other than Linux, or where the
 //! mapping fails, stay in their `Vec`: the pages are a speed-up, never a requirement.

@@ -15,7 +15,8 @@
 //! most; nodes and packets are aligned to cache lines so none straddles one line more than it
 //! must, and the children a ray will visit later are touched when stacked so their lines load
 //! in the meantime. On the 1.31M-triangle icosphere: 84,627 nodes of 7.0 children on average,
-//! 505,096 packets of 2.6 triangles, 102 bytes per triangle.
+//! 505,096 packets of 2.6 triangles, 90.5 bytes per triangle. Arrays that large live on
+//! transparent huge pages ([`Pages`]), so the visits are not also TLB misses.
 //!
 //! Everything is safe Rust: the lanes are glam's `Vec4`, which is an SSE register on x86-64.
 
