@@ -327,11 +327,28 @@ impl WideBvh {
                 let node = &nodes[current as usize];
                 let (t_near, mask) = ray.boxes(node, t_min, t_best);
                 if mask != 0 {
-                    if mask & (mask - 1) == 0 {
+                    let rest = mask & (mask - 1);
+                    if rest == 0 {
                         current = node.child[mask.trailing_zeros() as usize & 7];
                         continue;
                     }
-                    // Two to eight children: sort them by entry distance, nearest first.
+                    if rest & (rest - 1) == 0 {
+                        // Exactly two: no sort, the nearer goes next and the other is stacked
+                        // (the order the sort below would give, ties to the lower lane).
+                        let (a, b) = (
+                            mask.trailing_zeros() as usize & 7,
+                            rest.trailing_zeros() as usize & 7,
+                        );
+                        let t = [t_near[0].to_array(), t_near[1].to_array()];
+                        let (ta, tb) = (t[a >> 2][a & 3], t[b >> 2][b & 3]);
+                        let (near, far, t_far) = if tb < ta { (b, a, ta) } else { (a, b, tb) };
+                        let far_child = node.child[far];
+                        warm ^= touch(nodes, packets, far_child);
+                        stack.push((far_child, t_far));
+                        current = node.child[near];
+                        continue;
+                    }
+                    // Three to eight children: sort them by entry distance, nearest first.
                     let mut hits = [(0u32, 0f32); ARITY];
                     let n = by_entry(mask, t_near, |lane| node.child[lane], &mut hits);
                     for &entry in hits[1..n].iter().rev() {
