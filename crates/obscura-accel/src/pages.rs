@@ -68,14 +68,14 @@ impl<T: Pod> Pages<T> {
 fn mapped<T: Pod>(items: &[T]) -> Option<Store<T>> {
     let bytes: &[u8] = bytemuck::cast_slice(items);
     let mut map = memmap2::MmapMut::map_anon(bytes.len()).ok()?;
+    // Anonymous mappings start at a page boundary, far beyond any element's alignment; check
+    // rather than assume (before copying anything), and keep the vector if not.
+    bytemuck::try_cast_slice::<u8, T>(&map).ok()?;
     // Advise before the first write: the pages are faulted in by the copy below, and only
     // faults in an advised range are served with huge pages. If the kernel has transparent
     // huge pages disabled the advice fails and ordinary pages serve the mapping.
     let _ = map.advise(memmap2::Advice::HugePage);
     map.copy_from_slice(bytes);
-    // Anonymous mappings start at a page boundary, far beyond any element's alignment; check
-    // rather than assume, and keep the vector if not.
-    bytemuck::try_cast_slice::<u8, T>(&map).ok()?;
     Some(Store::Mapped(map, PhantomData))
 }
 
@@ -91,8 +91,7 @@ impl<T: Pod> Deref for Pages<T> {
     fn deref(&self) -> &[T] {
         match &self.store {
             Store::Heap(v) => v,
-            // The cast was checked when the mapping was made, so the empty fallback is never
-            // taken (and costs no panic path in every query).
+            // The cast was checked when the mapping was made, so it cannot panic here.
             Store::Mapped(map, _) => bytemuck::cast_slice(map),
         }
     }

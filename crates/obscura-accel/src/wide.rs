@@ -387,7 +387,7 @@ impl WideBvh {
             loop {
                 let Some((next, t_entry)) = stack.pop() else {
                     std::hint::black_box(warm);
-                    return best.map(|(index, lane, tri)| self.hit_record(index, lane, tri));
+                    return best.map(|(index, lane, tri)| hit_record(&packets[index], lane, tri));
                 };
                 if t_entry <= t_best {
                     current = next;
@@ -433,22 +433,21 @@ impl WideBvh {
         }
     }
 
-    /// The full record of a hit on lane `lane` of packet `index`.
-    fn hit_record(&self, index: usize, lane: usize, tri: TriangleHit) -> WideHit {
-        let p = &self.packets[index];
-        let at = |v: &[Vec4; 3]| Vec3::new(v[0][lane], v[1][lane], v[2][lane]);
-        WideHit {
-            ids: [p.ids[0][lane], p.ids[1][lane]],
-            tri,
-            v0: at(&p.v0),
-            e1: at(&p.e1),
-            e2: at(&p.e2),
-        }
-    }
-
     /// Bytes held by the nodes and packets (for the memory figures).
     pub(crate) fn heap_bytes(&self) -> usize {
         self.nodes.bytes() + self.packets.bytes()
+    }
+}
+
+/// The full record of a hit on lane `lane` of packet `p`.
+fn hit_record(p: &Packet, lane: usize, tri: TriangleHit) -> WideHit {
+    let at = |v: &[Vec4; 3]| Vec3::new(v[0][lane], v[1][lane], v[2][lane]);
+    WideHit {
+        ids: [p.ids[0][lane], p.ids[1][lane]],
+        tri,
+        v0: at(&p.v0),
+        e1: at(&p.e1),
+        e2: at(&p.e2),
     }
 }
 
