@@ -173,13 +173,14 @@ impl Sampler {
     }
 
     /// Dimensions `first` and `first + 1` (`first` even), as two [`Sampler::value_keyed`]
-    /// calls would give them; Sobol computes its per-pair hashes once.
+    /// calls would give them; Sobol computes its per-pair hashes once. `index_reversed` is
+    /// `index.reverse_bits()`, which a stream computes once.
     #[inline]
-    fn pair_keyed(&self, pixel_key: u64, index: u32, first: u32) -> Vec2 {
+    fn pair_keyed(&self, pixel_key: u64, index: u32, index_reversed: u32, first: u32) -> Vec2 {
         match self.kind {
-            SamplerKind::Sobol if first.is_multiple_of(2) => {
-                Vec2::from(sequences::sobol_pair(pixel_key, index, first / 2))
-            }
+            SamplerKind::Sobol if first.is_multiple_of(2) => Vec2::from(
+                sequences::sobol_pair_reversed(pixel_key, index_reversed, first / 2),
+            ),
             _ => Vec2::new(
                 self.value_keyed(pixel_key, index, first),
                 self.value_keyed(pixel_key, index, first.saturating_add(1)),
@@ -194,6 +195,7 @@ impl Sampler {
             sampler: self,
             pixel_key: self.key(pixel),
             index,
+            index_reversed: index.reverse_bits(),
             dimension: 0,
             sobol_last: None,
         }
@@ -226,6 +228,8 @@ pub struct SampleStream<'a> {
     sampler: &'a Sampler,
     pixel_key: u64,
     index: u32,
+    /// `index.reverse_bits()`: Sobol's index shuffle starts from it for every pair.
+    index_reversed: u32,
     dimension: u32,
     /// Sobol only: the shared part of the pair last read one dimension at a time, so reading
     /// its other dimension next costs one scramble (the values are the same either way).
@@ -239,8 +243,8 @@ impl SampleStream<'_> {
     pub fn camera(&mut self) -> CameraDims {
         let (sampler, key, index) = (self.sampler, self.pixel_key, self.index);
         let dims = CameraDims {
-            film: sampler.pair_keyed(key, index, 0),
-            lens: sampler.pair_keyed(key, index, 2),
+            film: sampler.pair_keyed(key, index, self.index_reversed, 0),
+            lens: sampler.pair_keyed(key, index, self.index_reversed, 2),
             time: self.one(4),
         };
         self.dimension = self.dimension.max(5);
@@ -268,7 +272,8 @@ impl SampleStream<'_> {
         let prepared = match self.sobol_last {
             Some(last) if last.pair == pair => last,
             _ => {
-                let prepared = sequences::sobol_prepare(self.pixel_key, self.index, pair);
+                let prepared =
+                    sequences::sobol_prepare_reversed(self.pixel_key, self.index_reversed, pair);
                 self.sobol_last = Some(prepared);
                 prepared
             }
@@ -280,7 +285,9 @@ impl SampleStream<'_> {
     #[inline]
     pub fn next_2d(&mut self) -> Vec2 {
         let first = self.dimension.saturating_add(self.dimension % 2);
-        let u2 = self.sampler.pair_keyed(self.pixel_key, self.index, first);
+        let u2 = self
+            .sampler
+            .pair_keyed(self.pixel_key, self.index, self.index_reversed, first);
         self.dimension = first.saturating_add(2);
         u2
     }

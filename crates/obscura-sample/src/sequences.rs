@@ -248,6 +248,20 @@ pub(crate) fn sobol_prepare(key: u64, index: u32, pair: u32) -> SobolPair {
     }
 }
 
+/// [`sobol_prepare`] given the sample index with its bits reversed, as a sample's stream
+/// holds it: the index shuffle is [`owen_scramble`], which reverses its input first, and a
+/// stream reads several pairs of one index, so it reverses once, not once per pair. The
+/// stream's values are checked against [`sobol`]'s (`tests/it/determinism.rs`).
+#[inline]
+pub(crate) fn sobol_prepare_reversed(key: u64, index_reversed: u32, pair: u32) -> SobolPair {
+    let pair_key = combine(key, u64::from(pair));
+    SobolPair {
+        pair,
+        pair_key,
+        shuffled: owen_hash(index_reversed, pair_key as u32).reverse_bits(),
+    }
+}
+
 /// The shared part of one Sobol pair, from [`sobol_prepare`].
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct SobolPair {
@@ -257,18 +271,19 @@ pub(crate) struct SobolPair {
     shuffled: u32,
 }
 
-/// The key [`sobol`] and [`sobol_pair`] take: the pixel's key tagged for this sampler.
+/// The key [`sobol`] and [`sobol_pair_reversed`] take: the pixel's key tagged for this sampler.
 #[inline]
 pub(crate) fn sobol_key(pixel_key: u64) -> u64 {
     combine(pixel_key, TAG_SOBOL)
 }
 
-/// Both coordinates of pair `pair` (dimensions `2 pair` and `2 pair + 1`): the same values as
-/// two [`sobol`] calls, with the pair's key and index shuffle computed once (the sampler is a
-/// third of a path-traced render's time, mostly hashing).
+/// Both coordinates of pair `pair` (dimensions `2 pair` and `2 pair + 1`) of the sample whose
+/// index reversed is `index_reversed` (see [`sobol_prepare_reversed`]): the same values as two
+/// [`sobol`] calls, with the pair's key and index shuffle computed once (the sampler is a
+/// sixth of a path-traced render's instructions, mostly hashing).
 #[inline]
-pub(crate) fn sobol_pair(key: u64, index: u32, pair: u32) -> [f32; 2] {
-    let prepared = sobol_prepare(key, index, pair);
+pub(crate) fn sobol_pair_reversed(key: u64, index_reversed: u32, pair: u32) -> [f32; 2] {
+    let prepared = sobol_prepare_reversed(key, index_reversed, pair);
     [sobol_coordinate(prepared, 0), sobol_coordinate(prepared, 1)]
 }
 
