@@ -185,14 +185,10 @@ impl Prepared {
     fn new(o: Vec3A, d: Vec3A) -> Prepared {
         // A zero component would give 0 * inf = NaN on a slab through the origin; a tiny
         // stand-in of the same sign gives the same slab answer with finite arithmetic.
-        let safe = |c: f32| {
-            if c.abs() < 1e-30 {
-                1e-30f32.copysign(c)
-            } else {
-                c
-            }
-        };
-        let inv = [1.0 / safe(d.x), 1.0 / safe(d.y), 1.0 / safe(d.z)];
+        // (Three lanes at once: one division instruction instead of three.)
+        let tiny = Vec3A::splat(1e-30);
+        let safe = Vec3A::select(d.abs().cmplt(tiny), tiny.copysign(d), d);
+        let inv = (Vec3A::ONE / safe).to_array();
         Prepared {
             o: [Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z)],
             d: [Vec4::splat(d.x), Vec4::splat(d.y), Vec4::splat(d.z)],
