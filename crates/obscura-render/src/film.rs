@@ -85,7 +85,7 @@ impl Filter {
 
     /// The profile at the `n <= SPAN` offsets `c - (first + k + 0.5)`, `k = 0..n`, from a
     /// sample coordinate `c` to the centres of the pixels `first..first + n` (a splat's
-    /// columns or rows); lanes from `n` on hold whatever the filter gives there.
+    /// columns or rows); the lanes from `n` on are not to be read.
     #[inline]
     fn weights(&self, c: f32, first: u32, n: usize) -> [f32; SPAN] {
         const STEPS: [Vec4; 2] = [Vec4::new(0.5, 1.5, 2.5, 3.5), Vec4::new(4.5, 5.5, 6.5, 7.5)];
@@ -108,15 +108,16 @@ impl Filter {
 /// evaluates once per column and row (every filter at its default radius fits).
 const SPAN: usize = 8;
 
-/// `e^x` in four lanes, for `x <= 0` (the Gaussian's exponents), as the sum of powers that
-/// libm's `expf` approximates: within one ulp of the correctly rounded value over a dense
-/// sweep of `[-87, 0]` (the tests allow two), and flushed to `e^-87` below that. Four lanes of SSE
-/// arithmetic instead of four calls into libm, which were a quarter of a splat's instructions.
+/// `e^x` in four lanes, for `x <= 0` (the Gaussian's exponents): within one ulp of the
+/// correctly rounded value over a dense sweep of `[-87, 0]` (the tests allow two), `e^-87`
+/// below that and 1 above 0. Four lanes of SSE arithmetic instead of four calls into libm's
+/// `expf`, which were a quarter of a splat's instructions.
 ///
 /// Cody and Waite's reduction: `x = n ln 2 + r` with `n` the nearest integer to `x / ln 2`, so
 /// `|r| <= ln 2 / 2`; `ln 2` is split into a high part with few enough bits that `n` times it
 /// is exact and a low part for the rest. Then `e^r` is its Taylor series to `r^7` (the first
-/// term left out is below `6e-9 e^r`), and `2^n` is built in the exponent bits.
+/// term left out is below `8e-9 e^r`, a tenth of an ulp), and `2^n` is built in the exponent
+/// bits.
 #[inline]
 fn exp4(x: Vec4) -> Vec4 {
     /// `ln 2` to 9 bits (355 / 512), so that `n * LN2_HI` is exact for `|n| < 2^15`.
