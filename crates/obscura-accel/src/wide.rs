@@ -177,7 +177,7 @@ pub(crate) struct WideBvh {
 struct Prepared {
     o: [Vec4; 3],
     d: [Vec4; 3],
-    inv: [Vec4; 3],
+    inv: [f32; 3],
     /// 1 where the direction is negative (the box's max plane is met first), else 0.
     near: [usize; 3],
 }
@@ -194,19 +194,20 @@ impl Prepared {
         Prepared {
             o: [Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z)],
             d: [Vec4::splat(d.x), Vec4::splat(d.y), Vec4::splat(d.z)],
-            inv: inv.map(Vec4::splat),
+            inv,
             near: inv.map(|i| usize::from(i < 0.0)),
         }
     }
 
-    /// The entry distance of each child's box and the mask of children the ray enters within
-    /// `[t_min, t_max]`.
+    /// The entry distance of each of the node's first `N` children's boxes and the mask of
+    /// those the ray enters within `[t_min, t_max]` (`N` a multiple of four: eight for a BVH
+    /// node, four for a top level of few boxes). Written over plain arrays, which the compiler
+    /// vectorises: one SSE register per four lanes on baseline x86-64 (one AVX register for
+    /// eight when built for a CPU that has it, measured no faster). The `if`s are
+    /// `maxps`/`minps` exactly, NaN operands included.
     #[inline(always)]
-    fn boxes(&self, node: &Node, t_min: f32, t_max: f32) -> ([f32; ARITY], u32) {
-        // The same arithmetic as `half`, written over plain eight-lane arrays: the compiler
-        // makes it two SSE registers' worth of instructions on baseline x86-64, and one AVX
-        // register's when built for a CPU that has AVX (`-C target-cpu=native`). The `if`s
-        // are `maxps`/`minps` exactly, NaN operands included.
+    fn slabs<const N: usize>(&self, node: &Node, t_min: f32, t_max: f32) -> ([f32; N], u32) {
+        const { assert!(N.is_multiple_of(WIDTH) && N <= ARITY) };
         #[inline(always)]
         fn max(a: f32, b: f32) -> f32 {
             if a > b { a } else { b }
@@ -215,15 +216,18 @@ impl Prepared {
         fn min(a: f32, b: f32) -> f32 {
             if a < b { a } else { b }
         }
-        let plane = |i: usize| -> &[f32; ARITY] { bytemuck::cast_ref(&node.bounds[i]) };
+        let plane = |i: usize| -> &[f32; N] {
+            let lanes: &[f32; ARITY] = bytemuck::cast_ref(&node.bounds[i]);
+            lanes.first_chunk().expect("N <= ARITY")
+        };
         let (nx, ny, nz) = (self.near[0] & 1, self.near[1] & 1, self.near[2] & 1);
         let (near_x, far_x) = (plane(nx), plane(nx ^ 1));
         let (near_y, far_y) = (plane(2 + ny), plane(2 + (ny ^ 1)));
         let (near_z, far_z) = (plane(4 + nz), plane(4 + (nz ^ 1)));
-        let (o, inv) = (self.o.map(|v| v.x), self.inv.map(|v| v.x));
-        let mut t_near = [0.0; ARITY];
-        let mut t_far = [0.0; ARITY];
-        for lane in 0..ARITY {
+        let (o, inv) = (self.o.map(|v| v.x), self.inv);
+        let mut t_near = [0.0; N];
+        let mut t_far = [0.0; N];
+        for lane in 0..N {
             let tnx = (near_x[lane] - o[0]) * inv[0];
             let tfx = (far_x[lane] - o[0]) * inv[0];
             let tny = (near_y[lane] - o[1]) * inv[1];
@@ -232,36 +236,18 @@ impl Prepared {
             let tfz = (far_z[lane] - o[2]) * inv[2];
             t_near[lane] = max(max(tnx, tny), max(tnz, t_min));
             let t = min(min(tfx, tfy), tfz);
-            // As in `half`: `t_max` first, so an unused lane's NaN is kept and not entered.
+            // `t_max` first: an unused lane's far distance is -inf, the slack makes it NaN,
+            // and `minps` then returns its second operand, NaN, which no entry distance is
+            // below.
             t_far[lane] = min(t_max, t + t.abs() * SLAB_SLACK);
         }
-        // The mask as two four-lane compares: the compiler does not find one `movmskps` in
-        // an eight-lane loop.
-        let enters = |h: usize| {
-            let near = Vec4::from_slice(&t_near[4 * h..]);
-            near.cmple(Vec4::from_slice(&t_far[4 * h..])).bitmask()
-        };
-        (t_near, enters(0) | (enters(1) << 4))
-    }
-
-    /// The slab test of [`Prepared::boxes`] for children `4h..4h + 4` only, in one register
-    /// (the few-box top level's path, and the reference `boxes` is tested against).
-    #[inline(always)]
-    fn half(&self, node: &Node, h: usize, t_min: f32, t_max: f32) -> (Vec4, u32) {
-        let b = &node.bounds;
-        let (nx, ny, nz) = (self.near[0] & 1, self.near[1] & 1, self.near[2] & 1);
-        let tnx = (b[nx][h] - self.o[0]) * self.inv[0];
-        let tfx = (b[nx ^ 1][h] - self.o[0]) * self.inv[0];
-        let tny = (b[2 + ny][h] - self.o[1]) * self.inv[1];
-        let tfy = (b[2 + (ny ^ 1)][h] - self.o[1]) * self.inv[1];
-        let tnz = (b[4 + nz][h] - self.o[2]) * self.inv[2];
-        let tfz = (b[4 + (nz ^ 1)][h] - self.o[2]) * self.inv[2];
-        let t_near = tnx.max(tny).max(tnz.max(Vec4::splat(t_min)));
-        let t_far = tfx.min(tfy).min(tfz);
-        // `t_max` first: an unused lane's far distance is -inf, the slack makes it NaN, and
-        // `minps` then returns its second operand, NaN, which no entry distance is below.
-        let t_far = Vec4::splat(t_max).min(t_far + t_far.abs() * SLAB_SLACK);
-        (t_near, t_near.cmple(t_far).bitmask())
+        // The mask four lanes at a time: the compiler does not find `movmskps` in the loop.
+        let mut mask = 0;
+        for h in 0..N / WIDTH {
+            let near = Vec4::from_slice(&t_near[WIDTH * h..]);
+            mask |= near.cmple(Vec4::from_slice(&t_far[WIDTH * h..])).bitmask() << (WIDTH * h);
+        }
+        (t_near, mask)
     }
 
     /// The lanes of `p` the ray hits within `[t_min, t_max]`, with their distances and
@@ -362,7 +348,7 @@ impl WideBvh {
         loop {
             if current & LEAF == 0 {
                 let node = &nodes[current as usize];
-                let (t_near, mask) = ray.boxes(node, t_min, t_best);
+                let (t_near, mask) = ray.slabs::<ARITY>(node, t_min, t_best);
                 if mask != 0 {
                     let rest = mask & (mask - 1);
                     if rest == 0 {
@@ -442,7 +428,7 @@ impl WideBvh {
         loop {
             if current & LEAF == 0 {
                 let node = &nodes[current as usize];
-                let (_, mut mask) = ray.boxes(node, t_min, t_max);
+                let (_, mut mask) = ray.slabs::<ARITY>(node, t_min, t_max);
                 if mask != 0 {
                     current = node.child[mask.trailing_zeros() as usize & 7];
                     mask &= mask - 1;
@@ -544,12 +530,12 @@ impl BoxSet {
     fn test(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> ([f32; ARITY], u32) {
         let ray = Prepared::new(o, d);
         let (t_near, mask) = if self.len <= WIDTH {
-            let (near_lo, mask_lo) = ray.half(&self.node, 0, t_min, t_max);
+            let (near, mask) = ray.slabs::<WIDTH>(&self.node, t_min, t_max);
             let mut t_near = [f32::INFINITY; ARITY];
-            t_near[..WIDTH].copy_from_slice(&near_lo.to_array());
-            (t_near, mask_lo)
+            t_near[..WIDTH].copy_from_slice(&near);
+            (t_near, mask)
         } else {
-            ray.boxes(&self.node, t_min, t_max)
+            ray.slabs::<ARITY>(&self.node, t_min, t_max)
         };
         (t_near, mask & ((1u32 << self.len) - 1))
     }
@@ -1007,11 +993,12 @@ mod tests {
     }
 
     proptest::proptest! {
-        /// The eight-lane array form of the slab test gives, lane for lane and bit for bit,
-        /// what the four-lane form gives each half: entry distances and the mask, for boxes
-        /// of any shape (empty lanes included) and rays in any direction, axis-parallel too.
+        /// The four-lane slab test (a few-box top level) gives, lane for lane and bit for bit,
+        /// what the eight-lane one (a BVH node) gives its first four lanes, and an unused lane
+        /// is never entered: for boxes of any shape and rays in any direction, axis-parallel
+        /// too, with finite and infinite `t_max`.
         #[test]
-        fn boxes_is_half_twice(
+        fn slab_tests_agree_and_skip_unused_lanes(
             corners in proptest::collection::vec(proptest::array::uniform6(-8.0f32..8.0), ARITY),
             empty in proptest::collection::vec(proptest::bool::weighted(0.2), ARITY),
             o in proptest::array::uniform3(-10.0f32..10.0),
@@ -1032,17 +1019,14 @@ mod tests {
                 }
             }
             let ray = Prepared::new(Vec3A::from_array(o), Vec3A::from_array(d));
-            let (t_near, mask) = ray.boxes(&node, t_min, t_max);
-            let (lo, mask_lo) = ray.half(&node, 0, t_min, t_max);
-            let (hi, mask_hi) = ray.half(&node, 1, t_min, t_max);
-            proptest::prop_assert_eq!(mask, mask_lo | (mask_hi << 4));
-            let halves = [lo.to_array(), hi.to_array()].concat();
-            for lane in 0..ARITY {
-                if mask & (1 << lane) != 0 {
-                    proptest::prop_assert_eq!(t_near[lane].to_bits(), halves[lane].to_bits());
+            let (t_near, mask) = ray.slabs::<ARITY>(&node, t_min, t_max);
+            let (t_near4, mask4) = ray.slabs::<WIDTH>(&node, t_min, t_max);
+            proptest::prop_assert_eq!(mask4, mask & 0xf);
+            for lane in 0..WIDTH {
+                if mask4 & (1 << lane) != 0 {
+                    proptest::prop_assert_eq!(t_near4[lane].to_bits(), t_near[lane].to_bits());
                 }
             }
-            // And an empty lane is never entered.
             for (lane, _) in empty.iter().enumerate().filter(|(_, e)| **e) {
                 proptest::prop_assert_eq!(mask & (1 << lane), 0);
             }
