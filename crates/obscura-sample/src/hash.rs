@@ -90,12 +90,15 @@ pub(crate) fn permute(i: u32, n: u32, key: u64) -> u32 {
 /// Applied to an integer sample index instead of a fraction it permutes every aligned block
 /// of `2^m` indices onto an aligned block of `2^m` indices, which is how sample indices are
 /// shuffled without losing the net properties of the first `2^m` points.
-#[inline]
+///
+/// The definition the tests check; the samplers call [`owen_hash`] on values they already hold
+/// reversed.
+#[cfg(test)]
 pub(crate) fn owen_scramble(v: u32, seed: u32) -> u32 {
     owen_hash(v.reverse_bits(), seed).reverse_bits()
 }
 
-/// The body of [`owen_scramble`], on the bit-reversed value and giving the bit-reversed result:
+/// The body of `owen_scramble`, on the bit-reversed value and giving the bit-reversed result:
 /// `owen_scramble(v, s) == owen_hash(v.reverse_bits(), s).reverse_bits()`. Callers that hold a
 /// value already reversed save the two reversals (a dozen instructions each on x86-64).
 #[inline]

@@ -172,22 +172,6 @@ impl Sampler {
         }
     }
 
-    /// Dimensions `first` and `first + 1` (`first` even), as two [`Sampler::value_keyed`]
-    /// calls would give them; Sobol computes its per-pair hashes once. `index_reversed` is
-    /// `index.reverse_bits()`, which a stream computes once.
-    #[inline]
-    fn pair_keyed(&self, pixel_key: u64, index: u32, index_reversed: u32, first: u32) -> Vec2 {
-        match self.kind {
-            SamplerKind::Sobol if first.is_multiple_of(2) => Vec2::from(
-                sequences::sobol_pair_reversed(pixel_key, index_reversed, first / 2),
-            ),
-            _ => Vec2::new(
-                self.value_keyed(pixel_key, index, first),
-                self.value_keyed(pixel_key, index, first.saturating_add(1)),
-            ),
-        }
-    }
-
     /// A cursor over the dimensions of sample `index` of `pixel`. No heap allocation.
     #[inline]
     pub fn stream(&self, pixel: [u32; 2], index: u32) -> SampleStream<'_> {
@@ -241,10 +225,9 @@ impl SampleStream<'_> {
     /// dimensions 0-4 and moves the cursor to at least 5.
     #[inline]
     pub fn camera(&mut self) -> CameraDims {
-        let (sampler, key, index) = (self.sampler, self.pixel_key, self.index);
         let dims = CameraDims {
-            film: sampler.pair_keyed(key, index, self.index_reversed, 0),
-            lens: sampler.pair_keyed(key, index, self.index_reversed, 2),
+            film: self.pair(0),
+            lens: self.pair(2),
             time: self.one(4),
         };
         self.dimension = self.dimension.max(5);
@@ -281,13 +264,27 @@ impl SampleStream<'_> {
         sequences::sobol_coordinate(prepared, dimension % 2)
     }
 
+    /// Dimensions `first` and `first + 1` (`first` even), as two [`Sampler::value`] calls
+    /// would give them; Sobol computes its per-pair hashes once.
+    #[inline]
+    fn pair(&self, first: u32) -> Vec2 {
+        let (sampler, key, index) = (self.sampler, self.pixel_key, self.index);
+        match sampler.kind {
+            SamplerKind::Sobol if first.is_multiple_of(2) => Vec2::from(
+                sequences::sobol_pair_reversed(key, self.index_reversed, first / 2),
+            ),
+            _ => Vec2::new(
+                sampler.value_keyed(key, index, first),
+                sampler.value_keyed(key, index, first.saturating_add(1)),
+            ),
+        }
+    }
+
     /// The next aligned pair of dimensions, in `[0, 1)^2`.
     #[inline]
     pub fn next_2d(&mut self) -> Vec2 {
         let first = self.dimension.saturating_add(self.dimension % 2);
-        let u2 = self
-            .sampler
-            .pair_keyed(self.pixel_key, self.index, self.index_reversed, first);
+        let u2 = self.pair(first);
         self.dimension = first.saturating_add(2);
         u2
     }

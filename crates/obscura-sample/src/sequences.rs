@@ -7,8 +7,7 @@ use rand_core::Rng;
 use rand_pcg::Pcg32;
 
 use crate::hash::{
-    combine, in_stratum, mix64, owen_hash, owen_scramble, permute, unit_f32_from_bits,
-    unit_f64_from_bits,
+    combine, in_stratum, mix64, owen_hash, permute, unit_f32_from_bits, unit_f64_from_bits,
 };
 
 /// Tags that keep the hash streams of the samplers and of their parts apart.
@@ -240,18 +239,13 @@ pub(crate) fn sobol(key: u64, index: u32, dimension: u32) -> f32 {
 /// one scramble, not three.
 #[inline]
 pub(crate) fn sobol_prepare(key: u64, index: u32, pair: u32) -> SobolPair {
-    let pair_key = combine(key, u64::from(pair));
-    SobolPair {
-        pair,
-        pair_key,
-        shuffled: owen_scramble(index, pair_key as u32),
-    }
+    sobol_prepare_reversed(key, index.reverse_bits(), pair)
 }
 
 /// [`sobol_prepare`] given the sample index with its bits reversed, as a sample's stream
-/// holds it: the index shuffle is [`owen_scramble`], which reverses its input first, and a
-/// stream reads several pairs of one index, so it reverses once, not once per pair. The
-/// stream's values are checked against [`sobol`]'s (`tests/it/determinism.rs`).
+/// holds it: the index shuffle is the Owen scramble `owen_hash(index reversed, seed)`
+/// reversed, and a stream reads several pairs of one index, so it reverses once, not once
+/// per pair.
 #[inline]
 pub(crate) fn sobol_prepare_reversed(key: u64, index_reversed: u32, pair: u32) -> SobolPair {
     let pair_key = combine(key, u64::from(pair));
