@@ -695,6 +695,16 @@ impl Scene {
         }
     }
 
+    /// True when some instance moves (a placement given at shutter close): only then does a
+    /// ray's time change what it hits.
+    pub fn moves(&self) -> bool {
+        self.items.iter().any(|item| match item {
+            Item::Flat => false,
+            Item::Analytic { xform, .. } => matches!(xform, Xform::Moving(_)),
+            Item::MovingMesh { .. } => true,
+        })
+    }
+
     /// The box of everything in the scene, over all times.
     pub fn bounds(&self) -> Bounds3<World> {
         self.bounds

@@ -53,6 +53,14 @@ impl Camera for AnyCamera {
     fn world_from_camera(&self) -> &AnimatedTransform<World, CameraSpace> {
         dispatch!(self, c => c.world_from_camera())
     }
+    #[inline]
+    fn uses_lens_sample(&self) -> bool {
+        dispatch!(self, c => c.uses_lens_sample())
+    }
+    #[inline]
+    fn uses_time_sample(&self) -> bool {
+        dispatch!(self, c => c.uses_time_sample())
+    }
 }
 
 impl From<PerspectiveCamera> for AnyCamera {

@@ -90,6 +90,22 @@ pub trait Camera: Send + Sync {
 
     /// The camera's pose over the shutter interval.
     fn world_from_camera(&self) -> &AnimatedTransform<World, CameraSpace>;
+
+    /// Whether rays depend on [`CameraSample::p_lens`]: true for a thin lens with an
+    /// aperture. When false, every lens sample gives the same ray, so a renderer may leave
+    /// `p_lens` at [`CameraSample::at`]'s lens centre instead of drawing it. The default,
+    /// true, is always safe.
+    fn uses_lens_sample(&self) -> bool {
+        true
+    }
+
+    /// Whether rays depend on [`CameraSample::time`]: true when the shutter stays open over
+    /// an interval. When false, every time sample maps to the opening time (`time_at(u)` is
+    /// `open + u * 0`), so a renderer may leave `time` at 0 instead of drawing it.
+    fn uses_time_sample(&self) -> bool {
+        let shutter = self.shutter();
+        shutter.open < shutter.close
+    }
 }
 
 /// A thin lens: the aperture radius, the distance of the plane in focus, and the aperture's
@@ -350,6 +366,8 @@ pub(crate) trait CameraRayModel {
     type WorldMap: Copy;
 
     fn base(&self) -> &CameraBase;
+    /// Whether the rays depend on the lens sample (see [`Camera::uses_lens_sample`]).
+    fn uses_lens(&self) -> bool;
     /// The camera-space ray (the general path, used for projective poses).
     fn ray_camera(&self, p_film: Point2<Raster>, u_lens: glam::Vec2) -> Ray<CameraSpace>;
     /// The fast path's constants for an affine pose.
@@ -502,6 +520,10 @@ macro_rules! camera_via_model {
             ) -> &obscura_space::AnimatedTransform<obscura_space::World, obscura_space::Camera>
             {
                 &$crate::camera::CameraRayModel::base(self).world_from_camera
+            }
+            #[inline]
+            fn uses_lens_sample(&self) -> bool {
+                $crate::camera::CameraRayModel::uses_lens(self)
             }
         }
     };

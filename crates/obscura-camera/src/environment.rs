@@ -83,6 +83,11 @@ impl CameraRayModel for EnvironmentCamera {
     }
 
     #[inline]
+    fn uses_lens(&self) -> bool {
+        false
+    }
+
+    #[inline]
     fn ray_camera(&self, p_film: Point2<Raster>, _u_lens: glam::Vec2) -> Ray<CameraSpace> {
         Ray::new(Point3::ORIGIN, self.direction(p_film), 0.0)
             .with_range(self.base.near, self.base.far)

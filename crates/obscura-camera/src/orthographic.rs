@@ -110,6 +110,11 @@ impl CameraRayModel for OrthographicCamera {
     }
 
     #[inline]
+    fn uses_lens(&self) -> bool {
+        self.projective.lens().is_thin_lens()
+    }
+
+    #[inline]
     fn ray_camera(&self, p_film: Point2<Raster>, u_lens: glam::Vec2) -> Ray<CameraSpace> {
         // The film point (x, y) in world units; its ray starts on z = 0 and runs along +z.
         let p_camera = self.projective.film_point(p_film);

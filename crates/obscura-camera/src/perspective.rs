@@ -150,6 +150,11 @@ impl CameraRayModel for PerspectiveCamera {
     }
 
     #[inline]
+    fn uses_lens(&self) -> bool {
+        self.projective.lens().is_thin_lens()
+    }
+
+    #[inline]
     fn ray_camera(&self, p_film: Point2<Raster>, u_lens: glam::Vec2) -> Ray<CameraSpace> {
         // The film point on the near plane gives the pinhole direction from the eye.
         let p_camera = self.projective.film_point(p_film);

@@ -3,7 +3,7 @@
 use crate::reference::{
     Rng, TestScene, check_ray, random_placement, random_ray, random_shape, triangle_soup,
 };
-use obscura_accel::{Placement, Shape, TriangleMesh, load_obj};
+use obscura_accel::{Hit, Placement, Shape, TriangleMesh, load_obj};
 use obscura_space::Transform;
 use proptest::prelude::*;
 use std::fmt::Write as _;
@@ -91,6 +91,26 @@ proptest! {
     #[test]
     fn moving_scenes_match_brute_force_at_the_ray_time(seed in any::<u64>()) {
         check_scene(seed, 0.6, 400)?;
+    }
+
+    /// `Scene::moves` (which lets a renderer skip drawing ray times) says yes exactly when an
+    /// instance is placed moving; when it says no, a ray's time changes none of its hits.
+    #[test]
+    fn a_scene_moves_exactly_when_an_instance_does(seed in any::<u64>()) {
+        let test = random_scene(seed, 0.2);
+        let moving = test.instances.iter().any(|(_, p)| matches!(p, Placement::Moving(_)));
+        prop_assert_eq!(test.scene.moves(), moving);
+        if !moving {
+            let mut rng = Rng(seed ^ 0x5EED);
+            for _ in 0..50 {
+                let mut ray = random_ray(&mut rng);
+                ray.time = 0.0;
+                let early = test.scene.intersect(&ray);
+                ray.time = 0.7;
+                let late = test.scene.intersect(&ray).map(|h| Hit { time: 0.0, ..h });
+                prop_assert_eq!(early, late);
+            }
+        }
     }
 }
 

@@ -11,6 +11,7 @@ mod environment;
 mod exact;
 mod motion;
 mod projective;
+mod sample_use;
 mod thin_lens;
 mod validation;
 

@@ -185,6 +185,25 @@ proptest! {
         prop_assert_eq!(stream.next_2d(), Vec2::new(v(10), v(11)));
     }
 
+    /// A camera that skips its lens or time reads the same film values, gets the neutral
+    /// values for what it skips, and leaves every later dimension as it was.
+    #[test]
+    fn skipping_camera_dimensions_changes_nothing_after_them(
+        kind in prop::sample::select(SamplerKind::ALL.to_vec()),
+        seed: u64, pixel: [u32; 2], index in 0u32..1000, lens: bool, time: bool,
+    ) {
+        let s = sampler(kind, 16, seed);
+        let v = |d| s.value(pixel, index, d);
+        let mut stream = s.stream(pixel, index);
+        let dims = stream.camera_with(lens, time);
+        prop_assert_eq!(dims.film, Vec2::new(v(0), v(1)));
+        let lens_value = if lens { Vec2::new(v(2), v(3)) } else { Vec2::splat(0.5) };
+        prop_assert_eq!(dims.lens, lens_value);
+        prop_assert_eq!(dims.time, if time { v(4) } else { 0.0 });
+        prop_assert_eq!(stream.next_1d(), v(5));
+        prop_assert_eq!(stream.next_2d(), Vec2::new(v(6), v(7)));
+    }
+
     /// Any mix of single and paired reads gives exactly the sampler's values for the
     /// dimensions read (the stream keeps a Sobol pair's shared part between single reads;
     /// that must never change a value).
