@@ -164,38 +164,45 @@ pub(crate) fn halton(pixel_key: u64, index: u32, dimension: u32) -> f32 {
 
 /// The second dimension of the Sobol sequence as a 32-bit binary fraction: its generator
 /// matrix is Pascal's triangle modulo 2, whose successive columns `v` are obtained by
-/// `v ^= v >> 1` from `v = 1 << 31`.
+/// `v ^= v >> 1` from `v = 1 << 31`. Read from [`raw_pair_reversed`]'s tables, as the
+/// sampler reads it.
 #[cfg(test)]
 pub(crate) fn sobol_second(index: u32) -> u32 {
-    sobol_second_reversed(index).reverse_bits()
+    raw_pair_reversed(index.reverse_bits())[1].reverse_bits()
 }
 
-/// [`sobol_second_bitwise`]`(index).reverse_bits()`: the second Sobol dimension with its bits
-/// reversed, as the Owen scramble consumes it.
+/// Both raw coordinates of a pair's (0,2)-sequence point, bit-reversed as the Owen scramble
+/// consumes them, from the shuffled sample index *with its bits reversed* (as the index
+/// shuffle gives it): the van der Corput value `shuffled.reverse_bits()` and
+/// `sobol_second_bitwise(shuffled)`, each reversed, for `shuffled =
+/// shuffled_reversed.reverse_bits()`.
 ///
-/// The product is linear over XOR (and bit reversal distributes over XOR), so it is read from
-/// four tables of 256 entries, one per byte of the index: the index is Owen-shuffled before it
-/// gets here, so it has all 32 bits set at random, and the bit-by-bit loop (the reference)
-/// mispredicted a branch per bit; the sampler was a third of a path-traced render's time.
+/// Both are linear over XOR in the index bits (bit reversal distributes over XOR), so they are
+/// read from four tables of 256 entries, one per byte, each entry holding the two coordinates
+/// of that byte (first in the low half). The index is Owen-shuffled before it gets here, so it
+/// has all 32 bits set at random: the bit-by-bit product (the reference) mispredicted a branch
+/// per bit, and the tables also spare the shuffle's bit reversal.
 #[inline]
-pub(crate) fn sobol_second_reversed(index: u32) -> u32 {
-    let [b0, b1, b2, b3] = index.to_le_bytes();
-    SOBOL_SECOND_BYTES_REVERSED[0][b0 as usize]
-        ^ SOBOL_SECOND_BYTES_REVERSED[1][b1 as usize]
-        ^ SOBOL_SECOND_BYTES_REVERSED[2][b2 as usize]
-        ^ SOBOL_SECOND_BYTES_REVERSED[3][b3 as usize]
+pub(crate) fn raw_pair_reversed(shuffled_reversed: u32) -> [u32; 2] {
+    let [b0, b1, b2, b3] = shuffled_reversed.to_le_bytes();
+    let both = RAW_PAIR_REVERSED[0][b0 as usize]
+        ^ RAW_PAIR_REVERSED[1][b1 as usize]
+        ^ RAW_PAIR_REVERSED[2][b2 as usize]
+        ^ RAW_PAIR_REVERSED[3][b3 as usize];
+    [both as u32, (both >> 32) as u32]
 }
 
-/// `SOBOL_SECOND_BYTES_REVERSED[k][b]` is the product of the generator matrix with byte `b`
-/// placed at bits `8k..8k + 8` of the index, bit-reversed, computed at compile time by the
-/// bitwise reference.
-static SOBOL_SECOND_BYTES_REVERSED: [[u32; 256]; 4] = {
-    let mut table = [[0u32; 256]; 4];
+/// `RAW_PAIR_REVERSED[k][b]`: [`raw_pair_reversed`] of byte `b` placed at bits `8k..8k + 8`,
+/// computed at compile time from the bitwise reference.
+static RAW_PAIR_REVERSED: [[u64; 256]; 4] = {
+    let mut table = [[0u64; 256]; 4];
     let mut k = 0;
     while k < 4 {
         let mut b = 0;
         while b < 256 {
-            table[k][b] = sobol_second_bitwise((b as u32) << (8 * k)).reverse_bits();
+            let shuffled = ((b as u32) << (8 * k)).reverse_bits();
+            let second = sobol_second_bitwise(shuffled).reverse_bits();
+            table[k][b] = shuffled as u64 | (second as u64) << 32;
             b += 1;
         }
         k += 1;
@@ -252,7 +259,7 @@ pub(crate) fn sobol_prepare_reversed(key: u64, index_reversed: u32, pair: u32) -
     SobolPair {
         pair,
         pair_key,
-        shuffled: owen_hash(index_reversed, pair_key as u32).reverse_bits(),
+        shuffled_reversed: owen_hash(index_reversed, pair_key as u32),
     }
 }
 
@@ -262,7 +269,16 @@ pub(crate) struct SobolPair {
     /// Which pair (dimensions `2 pair` and `2 pair + 1`).
     pub pair: u32,
     pair_key: u64,
-    shuffled: u32,
+    /// The shuffled sample index, its bits reversed ([`raw_pair_reversed`] takes it so).
+    shuffled_reversed: u32,
+}
+
+impl SobolPair {
+    /// The Owen scramble seed of coordinate `which` (0 or 1).
+    #[inline]
+    fn scramble_seed(&self, which: u32) -> u32 {
+        combine(self.pair_key, u64::from(which) + 1) as u32
+    }
 }
 
 /// The key [`sobol`] and [`sobol_pair_reversed`] take: the pixel's key tagged for this sampler.
@@ -273,12 +289,22 @@ pub(crate) fn sobol_key(pixel_key: u64) -> u64 {
 
 /// Both coordinates of pair `pair` (dimensions `2 pair` and `2 pair + 1`) of the sample whose
 /// index reversed is `index_reversed` (see [`sobol_prepare_reversed`]): the same values as two
-/// [`sobol`] calls, with the pair's key and index shuffle computed once (the sampler is a
-/// sixth of a path-traced render's instructions, mostly hashing).
+/// [`sobol`] calls, with the pair's key, index shuffle and raw coordinates computed once, and
+/// the two scrambled coordinates reversed together in one 64-bit reversal (the sampler is a
+/// sixth of a path-traced render's instructions, mostly hashing and bit reversal).
 #[inline]
 pub(crate) fn sobol_pair_reversed(key: u64, index_reversed: u32, pair: u32) -> [f32; 2] {
     let prepared = sobol_prepare_reversed(key, index_reversed, pair);
-    [sobol_coordinate(prepared, 0), sobol_coordinate(prepared, 1)]
+    let [raw0, raw1] = raw_pair_reversed(prepared.shuffled_reversed);
+    let h0 = owen_hash(raw0, prepared.scramble_seed(0));
+    let h1 = owen_hash(raw1, prepared.scramble_seed(1));
+    // Reversing h1:h0 as one 64-bit word puts h0 reversed in the high half, h1 reversed in
+    // the low.
+    let both = (u64::from(h1) << 32 | u64::from(h0)).reverse_bits();
+    [
+        unit_f32_from_bits((both >> 32) as u32),
+        unit_f32_from_bits(both as u32),
+    ]
 }
 
 /// Coordinate `which` (0 or 1) of the pair's (0,2)-sequence point at the shuffled index,
@@ -286,22 +312,19 @@ pub(crate) fn sobol_pair_reversed(key: u64, index_reversed: u32, pair: u32) -> [
 ///
 /// The raw coordinates are the van der Corput radical inverse (the index's bits reversed) and
 /// the second Sobol dimension; the scramble works on reversed bits, so both are formed
-/// reversed (the index itself, and [`sobol_second_reversed`]) and [`owen_hash`] reverses once:
-/// the same value as `owen_scramble(raw, seed)` with two bit reversals fewer.
+/// reversed ([`raw_pair_reversed`]) and [`owen_hash`] reverses once: the same value as
+/// `owen_scramble(raw, seed)` with two bit reversals fewer.
 #[inline]
 pub(crate) fn sobol_coordinate(prepared: SobolPair, which: u32) -> f32 {
-    let raw_reversed = if which == 0 {
-        prepared.shuffled
-    } else {
-        sobol_second_reversed(prepared.shuffled)
-    };
-    let scramble_seed = combine(prepared.pair_key, u64::from(which) + 1) as u32;
-    unit_f32_from_bits(owen_hash(raw_reversed, scramble_seed).reverse_bits())
+    let raw_reversed = raw_pair_reversed(prepared.shuffled_reversed)[(which & 1) as usize];
+    let scrambled = owen_hash(raw_reversed, prepared.scramble_seed(which));
+    unit_f32_from_bits(scrambled.reverse_bits())
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::hash::owen_scramble;
 
     #[test]
     fn primes_start_right_and_are_prime() {
@@ -332,9 +355,44 @@ mod tests {
         for _ in 0..100_000 {
             i = i.wrapping_mul(0x9e37_79b9).wrapping_add(0x7f4a_7c15);
             assert_eq!(sobol_second(i), sobol_second_bitwise(i), "index {i:#x}");
-            assert_eq!(
-                sobol_second_reversed(i),
-                sobol_second_bitwise(i).reverse_bits()
+            assert_eq!(raw_pair_reversed(i)[0], i.reverse_bits(), "index {i:#x}");
+        }
+    }
+
+    /// Sobol's values from their definition, one step at a time: the index shuffled by an
+    /// Owen scramble keyed per pair, the raw coordinate (van der Corput or the second Sobol
+    /// dimension, bit by bit), then its own Owen scramble.
+    fn sobol_definition(key: u64, index: u32, dimension: u32) -> f32 {
+        let pair_key = combine(key, u64::from(dimension / 2));
+        let shuffled = owen_scramble(index, pair_key as u32);
+        let raw = if dimension.is_multiple_of(2) {
+            shuffled.reverse_bits()
+        } else {
+            sobol_second_bitwise(shuffled)
+        };
+        let seed = combine(pair_key, u64::from(dimension % 2) + 1) as u32;
+        unit_f32_from_bits(owen_scramble(raw, seed))
+    }
+
+    proptest::proptest! {
+        #[test]
+        fn sobol_values_and_pairs_equal_the_definition(key: u64, index: u32, pair in 0u32..1000) {
+            let expected = [
+                sobol_definition(key, index, 2 * pair),
+                sobol_definition(key, index, 2 * pair + 1),
+            ];
+            proptest::prop_assert_eq!(
+                [sobol(key, index, 2 * pair), sobol(key, index, 2 * pair + 1)],
+                expected
+            );
+            proptest::prop_assert_eq!(sobol_pair_reversed(key, index.reverse_bits(), pair), expected);
+        }
+
+        #[test]
+        fn raw_pair_tables_equal_the_bitwise_definition(shuffled: u32) {
+            proptest::prop_assert_eq!(
+                raw_pair_reversed(shuffled.reverse_bits()),
+                [shuffled, sobol_second_bitwise(shuffled).reverse_bits()]
             );
         }
     }
