@@ -253,6 +253,14 @@ impl SampleStream<'_> {
         u
     }
 
+    /// Moves past the next dimension without computing it: the dimensions after it are
+    /// the same as after [`SampleStream::next_1d`]. For a decision with one outcome (a
+    /// material with one lobe, a scene with one light), whose number nothing reads.
+    #[inline]
+    pub fn skip_1d(&mut self) {
+        self.dimension = self.dimension.saturating_add(1);
+    }
+
     /// Dimension `dimension` alone: [`Sampler::value`], reusing the Sobol pair's shared part
     /// when the previous single read was the same pair's other dimension.
     #[inline]

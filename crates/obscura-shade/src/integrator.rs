@@ -17,6 +17,11 @@ pub trait SampleDims {
     fn next_1d(&mut self) -> f32;
     /// The next pair in `[0, 1)^2`.
     fn next_2d(&mut self) -> Vec2;
+    /// Moves past the next number, which nothing would read: the numbers after it must be
+    /// the same as after [`SampleDims::next_1d`]. The default draws it and drops it.
+    fn skip_1d(&mut self) {
+        self.next_1d();
+    }
 }
 
 impl SampleDims for SampleStream<'_> {
@@ -27,6 +32,10 @@ impl SampleDims for SampleStream<'_> {
     #[inline]
     fn next_2d(&mut self) -> Vec2 {
         SampleStream::next_2d(self)
+    }
+    #[inline]
+    fn skip_1d(&mut self) {
+        SampleStream::skip_1d(self)
     }
 }
 
@@ -301,7 +310,14 @@ impl PathIntegrator {
 
             // Next-event estimation: one light, chosen uniformly.
             if !material.is_specular() && !shading.lights.is_empty() {
-                let u_light = dims.next_1d();
+                // With one light there is nothing to choose: the number is skipped, not drawn
+                // (the sampler's later dimensions stay where they were).
+                let u_light = if shading.lights.len() > 1 {
+                    dims.next_1d()
+                } else {
+                    dims.skip_1d();
+                    0.5
+                };
                 let u2_light = dims.next_2d();
                 radiance += beta
                     * self.sample_light(
@@ -310,7 +326,13 @@ impl PathIntegrator {
             }
 
             // Continue the path by sampling the BSDF.
-            let u = dims.next_1d();
+            // Only a material with a choice of lobes reads `u` (see Material::reads_lobe_choice).
+            let u = if material.reads_lobe_choice() {
+                dims.next_1d()
+            } else {
+                dims.skip_1d();
+                0.5
+            };
             let u2 = dims.next_2d();
             let Some(bs) = material.sample(wo, u, u2) else {
                 break;

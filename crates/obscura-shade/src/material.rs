@@ -120,6 +120,13 @@ impl Material {
         }
     }
 
+    /// True when [`Material::sample`] reads its `u`, the choice between lobes (reflect or
+    /// refract, for glass). For every other material any `u` gives the same sample, and the
+    /// path tracer skips drawing it.
+    pub fn reads_lobe_choice(&self) -> bool {
+        matches!(self, Material::Dielectric { .. })
+    }
+
     /// True when the material tells inside from outside by the side of the normal (the
     /// integrator must then not flip the shading normal towards the viewer).
     pub fn is_oriented(&self) -> bool {

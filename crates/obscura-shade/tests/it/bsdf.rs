@@ -209,6 +209,40 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(300))]
+
+    /// The path tracer skips drawing `u` for a material that says it does not read it, so
+    /// such a material must sample the same for every `u`; glass, which reads it, reflects
+    /// for a small `u` and refracts for a large one at normal incidence (4% reflectance).
+    #[test]
+    fn only_a_material_that_reads_its_lobe_choice_depends_on_it(
+        theta in 0.01f32..1.56, phi in 0.0f32..TAU, below in any::<bool>(),
+        roughness in 0.0f32..1.0, u_a in 0.0f32..1.0, u_b in 0.0f32..1.0,
+        ux in 0.0f32..1.0, uy in 0.0f32..1.0, ior in 1.1f32..2.0,
+    ) {
+        let wo = if below { -dir(theta, phi) } else { dir(theta, phi) };
+        let u2 = Vec2::new(ux, uy);
+        let materials = [
+            Material::Diffuse { reflectance: Vec3::splat(0.7) },
+            Material::Mirror { reflectance: Vec3::splat(0.9) },
+            rough(0.9, roughness),
+            Material::Dielectric { ior },
+        ];
+        for m in materials {
+            if m.reads_lobe_choice() {
+                let up = Vec3::Z;
+                let reflect = m.sample(up, 0.001, u2).unwrap();
+                let refract = m.sample(up, 0.999, u2).unwrap();
+                prop_assert!(reflect.wi.z > 0.0 && refract.wi.z < 0.0, "{:?}", m);
+            } else {
+                let (a, b) = (m.sample(wo, u_a, u2), m.sample(wo, u_b, u2));
+                prop_assert_eq!(a.map(|s| (s.wi, s.f, s.pdf)), b.map(|s| (s.wi, s.f, s.pdf)), "{:?}", m);
+            }
+        }
+    }
+}
+
 /// Counts samples in (cos theta, phi) cells of the hemisphere of `wo` and compares with the
 /// counts the pdf predicts (the pdf integrated over each cell with a 6 x 6 midpoint rule).
 fn histogram_check(m: &Material, wo: Vec3, seed: u64) {
