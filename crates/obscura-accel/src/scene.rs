@@ -631,13 +631,17 @@ impl Scene {
             Top::Few(set) => {
                 let mut entered = [(0, 0.0); BoxSet::CAPACITY];
                 let n = set.entered(r.o, r.d, r.t_min, r.t_max, &mut entered);
+                // The best distance is kept beside the best hit, not read back from it: a
+                // `Found` is a 72-byte enum, and matching it for its `t` before every item
+                // was a jump table and stack copies on the hottest loop of small scenes.
                 let mut best: Option<Found> = None;
+                let mut t_best = r.t_max;
                 for &(item, t_entry) in &entered[..n] {
-                    let t_max = best.map_or(r.t_max, |f| f.t());
-                    if t_entry > t_max {
+                    if t_entry > t_best {
                         break;
                     }
-                    if let Some(f) = self.intersect_item(item, r, t_max) {
+                    if let Some(f) = self.intersect_item(item, r, t_best) {
+                        t_best = f.t();
                         best = Some(f);
                     }
                 }
