@@ -159,6 +159,18 @@ pub fn environment_strategy() -> impl Strategy<Value = EnvironmentCamera> {
         })
 }
 
+/// The three models over one base: perspective (60 degrees) and orthographic with `lens`,
+/// and the environment camera (which has none).
+pub fn models(base: CameraBase, lens: ThinLens) -> [AnyCamera; 3] {
+    [
+        PerspectiveCamera::new(base.clone(), 60.0, FovAxis::Smaller, lens)
+            .unwrap()
+            .into(),
+        OrthographicCamera::new(base.clone(), lens).unwrap().into(),
+        EnvironmentCamera::new(base).unwrap().into(),
+    ]
+}
+
 /// A raster position anywhere on the film of `resolution` (fractions in [0, 1)).
 pub fn raster_in(
     resolution: [u32; 2],

@@ -3,22 +3,15 @@
 
 use crate::{assert_close2, assert_close3, look_strategy};
 use obscura_camera::{
-    AnyCamera, Camera, CameraBase, CameraSample, EnvironmentCamera, FilmGeometry, FovAxis,
-    OrthographicCamera, PerspectiveCamera, Shutter, ThinLens, look_at_pose,
+    AnyCamera, Camera, CameraBase, CameraSample, FilmGeometry, FovAxis, PerspectiveCamera, Shutter,
+    ThinLens, look_at_pose,
 };
 use obscura_space::{Point2, Point3};
 use proptest::prelude::*;
 
-/// The three models over one base.
-fn models(base: CameraBase) -> Vec<AnyCamera> {
-    let lens = ThinLens::new(0.1, 3.0).unwrap();
-    vec![
-        PerspectiveCamera::new(base.clone(), 60.0, FovAxis::Smaller, lens)
-            .unwrap()
-            .into(),
-        OrthographicCamera::new(base.clone(), lens).unwrap().into(),
-        EnvironmentCamera::new(base).unwrap().into(),
-    ]
+/// The three models over one base, the projective ones with a thin lens.
+fn models(base: CameraBase) -> [AnyCamera; 3] {
+    crate::models(base, ThinLens::new(0.1, 3.0).unwrap())
 }
 
 proptest! {

@@ -2,24 +2,12 @@
 //! no, renderers skip drawing that dimension, so the ray must not depend on it; when it says
 //! yes, the ray must.
 
-use crate::look_strategy;
+use crate::{look_strategy, models};
 use obscura_camera::{
-    AnyCamera, Camera, CameraBase, CameraSample, EnvironmentCamera, FilmGeometry, FovAxis,
-    OrthographicCamera, PerspectiveCamera, Shutter, ThinLens, look_at_pose,
+    Camera, CameraBase, CameraSample, FilmGeometry, Shutter, ThinLens, look_at_pose,
 };
 use obscura_space::Point2;
 use proptest::prelude::*;
-
-/// The three models with `lens` (the environment camera has none) over one pose.
-fn models(base: CameraBase, lens: ThinLens) -> [AnyCamera; 3] {
-    [
-        PerspectiveCamera::new(base.clone(), 50.0, FovAxis::Smaller, lens)
-            .unwrap()
-            .into(),
-        OrthographicCamera::new(base.clone(), lens).unwrap().into(),
-        EnvironmentCamera::new(base).unwrap().into(),
-    ]
-}
 
 proptest! {
     #![proptest_config(crate::cases(128))]
