@@ -281,7 +281,9 @@ impl TileBuffer {
     }
 
     /// Adds a sample at raster position `p` with radiance `l` into every pixel the filter
-    /// reaches. `hit` says whether its camera ray hit geometry.
+    /// reaches. `hit` says whether its camera ray hit geometry. `l` must be finite (the
+    /// renderer counts and drops other samples before they get here): a NaN would reach every
+    /// pixel of the footprint, zero-weight ones included.
     pub fn add_sample(&mut self, p: Vec2, l: Vec3, hit: bool) {
         let r = self.filter.radius();
         // Pixels whose centre i + 0.5 lies in (p - r, p + r].
@@ -306,18 +308,18 @@ impl TileBuffer {
         let wx = self.filter.weights(p.x, x0, nx);
         let wy = self.filter.weights(p.y, y0, ny);
         let width = self.rect.width() as usize;
-        for (j, &w_row) in wy.iter().enumerate().take(ny) {
+        let first = (y0 - self.rect.y0) as usize * width + (x0 - self.rect.x0) as usize;
+        for (j, &w_row) in wy[..ny].iter().enumerate() {
             if w_row == 0.0 {
                 continue;
             }
-            let row =
-                (y0 - self.rect.y0) as usize * width + j * width + (x0 - self.rect.x0) as usize;
-            for (s, &w_col) in self.sums[row..row + nx].iter_mut().zip(&wx[..nx]) {
+            let row = first + j * width;
+            // No test for a zero weight: l is finite (the renderer drops other samples), so
+            // such a pixel gains a signed zero, and sums that start at +0 keep their bits.
+            for (s, &w_col) in self.sums[row..row + nx].iter_mut().zip(&wx) {
                 let w = w_row * w_col;
-                if w != 0.0 {
-                    s.weighted += l * w;
-                    s.coverage += w * coverage;
-                }
+                s.weighted += l * w;
+                s.coverage += w * coverage;
             }
         }
     }
