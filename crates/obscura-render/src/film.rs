@@ -61,7 +61,7 @@ impl Filter {
     }
 
     /// [`Filter::eval_1d`] at four offsets at once: lane `i` of the result is exactly
-    /// `eval_1d(d[i])`. The Gaussian's four exponentials are one [`exp4`].
+    /// `eval_1d(d[i])`. The Gaussian's four exponentials are one four-lane `exp4`.
     #[inline]
     pub fn eval_1d_x4(&self, d: Vec4) -> Vec4 {
         match self.settings {
