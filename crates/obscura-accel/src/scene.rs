@@ -348,6 +348,11 @@ impl SceneBuilder {
             Top::Tree(bvh, order)
         };
 
+        let moves = items.iter().any(|item| match item {
+            Item::Flat => false,
+            Item::Analytic { xform, .. } => matches!(xform, Xform::Moving(_)),
+            Item::MovingMesh { .. } => true,
+        });
         Ok(Scene {
             items,
             tlas,
@@ -356,6 +361,7 @@ impl SceneBuilder {
             meshes,
             statics,
             bounds,
+            moves,
         })
     }
 }
@@ -373,6 +379,8 @@ pub struct Scene {
     meshes: Vec<Option<Arc<TriangleMesh>>>,
     statics: Vec<Option<Transform<World, Object>>>,
     bounds: Bounds3<World>,
+    /// Whether an item moves (see [`Scene::moves`]), found once at build time.
+    moves: bool,
 }
 
 /// The top level of a [`Scene`].
@@ -700,13 +708,10 @@ impl Scene {
     }
 
     /// True when some instance moves (a placement given at shutter close): only then does a
-    /// ray's time change what it hits.
+    /// ray's time change what it hits. Constant time (found at build), so a renderer may ask
+    /// per tile.
     pub fn moves(&self) -> bool {
-        self.items.iter().any(|item| match item {
-            Item::Flat => false,
-            Item::Analytic { xform, .. } => matches!(xform, Xform::Moving(_)),
-            Item::MovingMesh { .. } => true,
-        })
+        self.moves
     }
 
     /// The box of everything in the scene, over all times.
