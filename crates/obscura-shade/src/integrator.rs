@@ -22,6 +22,17 @@ pub trait SampleDims {
     fn skip_1d(&mut self) {
         self.next_1d();
     }
+    /// The next number if `read`; otherwise skips it and returns 0.5, for a choice that has
+    /// one outcome (the dimensions after are the same either way).
+    #[inline]
+    fn next_1d_if(&mut self, read: bool) -> f32 {
+        if read {
+            self.next_1d()
+        } else {
+            self.skip_1d();
+            0.5
+        }
+    }
 }
 
 impl SampleDims for SampleStream<'_> {
@@ -310,14 +321,8 @@ impl PathIntegrator {
 
             // Next-event estimation: one light, chosen uniformly.
             if !material.is_specular() && !shading.lights.is_empty() {
-                // With one light there is nothing to choose: the number is skipped, not drawn
-                // (the sampler's later dimensions stay where they were).
-                let u_light = if shading.lights.len() > 1 {
-                    dims.next_1d()
-                } else {
-                    dims.skip_1d();
-                    0.5
-                };
+                // With one light there is nothing to choose: the number is skipped, not drawn.
+                let u_light = dims.next_1d_if(shading.lights.len() > 1);
                 let u2_light = dims.next_2d();
                 radiance += beta
                     * self.sample_light(
@@ -327,12 +332,7 @@ impl PathIntegrator {
 
             // Continue the path by sampling the BSDF.
             // Only a material with a choice of lobes reads `u` (see Material::reads_lobe_choice).
-            let u = if material.reads_lobe_choice() {
-                dims.next_1d()
-            } else {
-                dims.skip_1d();
-                0.5
-            };
+            let u = dims.next_1d_if(material.reads_lobe_choice());
             let u2 = dims.next_2d();
             let Some(bs) = material.sample(wo, u, u2) else {
                 break;
