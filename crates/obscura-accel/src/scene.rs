@@ -337,7 +337,8 @@ impl SceneBuilder {
         let tlas = if items.len() <= 1 {
             Top::One
         } else if let Some(set) = BoxSet::new(&aabbs) {
-            Top::Few(set)
+            let sorted = items.iter().any(|i| !matches!(i, Item::Analytic { .. }));
+            Top::Few { set, sorted }
         } else {
             let bvh = build_cwbvh(
                 &aabbs,
@@ -388,8 +389,11 @@ pub struct Scene {
 enum Top {
     /// Zero or one item: no top level.
     One,
-    /// A few items, their boxes tested at once.
-    Few(BoxSet),
+    /// A few items, their boxes tested at once. `sorted`: a closest-hit query visits the
+    /// boxes entered nearest first (when an item is a mesh, whose BVH query the best hit so
+    /// far prunes); otherwise in index order, which for a few spheres and quads costs less
+    /// than the sort.
+    Few { set: BoxSet, sorted: bool },
     /// obvhs's tree over the items, with its slot -> item map.
     Tree(CwBvh, Vec<u32>),
 }
@@ -636,7 +640,7 @@ impl Scene {
         match &self.tlas {
             Top::One if self.items.len() == 1 => self.intersect_item(0, r, r.t_max),
             Top::One => None,
-            Top::Few(set) => {
+            Top::Few { set, sorted: true } => {
                 let mut entered = [(0, 0.0); BoxSet::CAPACITY];
                 let n = set.entered(r.o, r.d, r.t_min, r.t_max, &mut entered);
                 // The best distance is kept beside the best hit, not read back from it: a
@@ -647,6 +651,26 @@ impl Scene {
                 for &(item, t_entry) in &entered[..n] {
                     if t_entry > t_best {
                         break;
+                    }
+                    if let Some(f) = self.intersect_item(item, r, t_best) {
+                        t_best = f.t();
+                        best = Some(f);
+                    }
+                }
+                best
+            }
+            Top::Few { set, sorted: false } => {
+                // Spheres and quads in index order: the sort (and the zeroed array it fills)
+                // cost more than the item tests it spared. One entered beyond the best hit so
+                // far is still skipped.
+                let (t_near, mut mask) = set.test(r.o, r.d, r.t_min, r.t_max);
+                let mut best: Option<Found> = None;
+                let mut t_best = r.t_max;
+                while mask != 0 {
+                    let item = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    if t_near[item & 7] > t_best {
+                        continue;
                     }
                     if let Some(f) = self.intersect_item(item, r, t_best) {
                         t_best = f.t();
@@ -682,7 +706,7 @@ impl Scene {
         match &self.tlas {
             Top::One if self.items.len() == 1 => self.occluded_item(0, &r),
             Top::One => false,
-            Top::Few(set) => {
+            Top::Few { set, .. } => {
                 // Any order will do for a shadow ray.
                 let mut mask = set.entered_mask(r.o, r.d, r.t_min, r.t_max);
                 while mask != 0 {

@@ -527,7 +527,7 @@ impl BoxSet {
     /// The entry distances and the mask of the boxes entered; four boxes or fewer take one
     /// register's worth of tests, not two.
     #[inline(always)]
-    fn test(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> ([f32; ARITY], u32) {
+    pub(crate) fn test(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> ([f32; ARITY], u32) {
         let ray = Prepared::new(o, d);
         let (t_near, mask) = if self.len <= WIDTH {
             let (near, mask) = ray.slabs::<WIDTH>(&self.node, t_min, t_max);

@@ -93,6 +93,31 @@ proptest! {
         check_scene(seed, 0.6, 400)?;
     }
 
+    /// Two to eight spheres and quads and no mesh: the top level visits the boxes a ray
+    /// enters in index order, not nearest first, and must still find the closest hit.
+    #[test]
+    fn a_few_spheres_and_quads_match_brute_force(seed in any::<u64>(), moving in any::<bool>()) {
+        let mut rng = Rng(seed);
+        let soup = Arc::new(triangle_soup(&mut rng, 4, 1.0));
+        let count = 2 + rng.index(7);
+        let instances = (0..count)
+            .map(|_| {
+                let shape = loop {
+                    let shape = random_shape(&mut rng, &soup);
+                    if !matches!(shape, Shape::Mesh(_)) {
+                        break shape;
+                    }
+                };
+                (shape, random_placement(&mut rng, if moving { 0.5 } else { 0.0 }))
+            })
+            .collect::<Vec<_>>();
+        let scene = TestScene::build(instances);
+        for _ in 0..400 {
+            let ray = random_ray(&mut rng);
+            check_ray(&scene, &ray).map_err(TestCaseError::fail)?;
+        }
+    }
+
     /// `Scene::moves` (which lets a renderer skip drawing ray times) says yes exactly when an
     /// instance is placed moving; when it says no, a ray's time changes none of its hits.
     #[test]
