@@ -26,6 +26,8 @@ pub struct Hit {
     /// Surface coordinates. Sphere: `(phi / 2pi, theta / pi)` with theta measured from the
     /// object's +z axis and phi from +x towards +y; quad: `(s, t)` along `edge_u`, `edge_v`;
     /// triangle: interpolated vertex uvs, or the barycentrics `(b1, b2)` of vertices 1 and 2.
+    /// Zero for every hit of a scene built
+    /// [`with_uv(false)`](crate::SceneBuilder::with_uv).
     pub uv: glam::Vec2,
     /// The instance index [`SceneBuilder::add`](crate::SceneBuilder::add) returned.
     pub instance: u32,

@@ -12,7 +12,9 @@
 //! - Scenes: [`SceneBuilder`] takes shapes with a [`Placement`] and builds a [`Scene`], which
 //!   answers [`Scene::intersect`] and [`Scene::occluded`] from any number of threads;
 //!   [`Scene::intersect_preliminary`] finds the same closest hit without building its full
-//!   record (distance, ids and barycentrics only, like Embree's `rtcIntersect1`).
+//!   record (distance, ids and barycentrics only, like Embree's `rtcIntersect1`);
+//!   [`SceneBuilder::with_uv`] turns off the hits' surface coordinates for callers that read
+//!   no textures.
 //! - Hits: [`Hit`] carries the world-space point with a conservative error bound, and
 //!   [`Hit::spawn_ray`] / [`Hit::spawn_ray_to`] offset new rays by that bound (pbrt's method), so
 //!   a surface does not shadow itself.

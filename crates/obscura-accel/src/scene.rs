@@ -85,6 +85,8 @@ impl BuildQuality {
 pub struct SceneBuilder {
     instances: Vec<(Shape, Placement)>,
     quality: BuildQuality,
+    /// Set by `with_uv(false)`.
+    no_uv: bool,
 }
 
 /// How far from the origin (in world units, per axis) any shape may reach, at any time.
@@ -99,6 +101,16 @@ impl SceneBuilder {
     /// Sets the build quality of the per-mesh BVHs.
     pub fn with_quality(mut self, quality: BuildQuality) -> Self {
         self.quality = quality;
+        self
+    }
+
+    /// Whether hits carry surface coordinates ([`Hit::uv`]; on by default). Off, every hit's
+    /// `uv` is zero and costs nothing: a sphere's takes an arccosine and an arctangent, a
+    /// mesh's a read of its uv array (on a large mesh, one more cache miss per hit). For
+    /// callers that read no textures, such as Obscura's own renderer.
+    /// [`PreliminaryHit::primitive_uv`] is not affected.
+    pub fn with_uv(mut self, uv: bool) -> Self {
+        self.no_uv = !uv;
         self
     }
 
@@ -363,6 +375,7 @@ impl SceneBuilder {
             statics,
             bounds,
             moves,
+            uv: !self.no_uv,
         })
     }
 }
@@ -382,6 +395,8 @@ pub struct Scene {
     bounds: Bounds3<World>,
     /// Whether an item moves (see [`Scene::moves`]), found once at build time.
     moves: bool,
+    /// Whether hits carry their surface coordinates ([`SceneBuilder::with_uv`]).
+    uv: bool,
 }
 
 /// The top level of a [`Scene`].
@@ -891,15 +906,19 @@ impl Scene {
                 let p_object = center + rel;
                 let err_object = gamma(5) * rel.abs() + gamma(2) * p_object.abs();
                 let n_object = rel / radius;
-                let theta = (rel.z / radius).clamp(-1.0, 1.0).acos();
-                let mut phi = rel.y.atan2(rel.x);
-                if phi < 0.0 {
-                    phi += 2.0 * core::f32::consts::PI;
-                }
-                let uv = Vec2::new(
-                    phi / (2.0 * core::f32::consts::PI),
-                    theta / core::f32::consts::PI,
-                );
+                let uv = if self.uv {
+                    let theta = (rel.z / radius).clamp(-1.0, 1.0).acos();
+                    let mut phi = rel.y.atan2(rel.x);
+                    if phi < 0.0 {
+                        phi += 2.0 * core::f32::consts::PI;
+                    }
+                    Vec2::new(
+                        phi / (2.0 * core::f32::consts::PI),
+                        theta / core::f32::consts::PI,
+                    )
+                } else {
+                    Vec2::ZERO
+                };
                 self.analytic_hit(r, t, p_object, err_object, n_object, uv, instance, xform)
             }
             Found::Quad { item, quad } => {
@@ -916,7 +935,11 @@ impl Scene {
                 let p_object = origin + su + sv;
                 let err_object = gamma(5) * (origin.abs() + su.abs() + sv.abs());
                 let n_object = edge_u.cross(edge_v);
-                let uv = Vec2::new(quad.s, quad.v);
+                let uv = if self.uv {
+                    Vec2::new(quad.s, quad.v)
+                } else {
+                    Vec2::ZERO
+                };
                 self.analytic_hit(
                     r, quad.t, p_object, err_object, n_object, uv, instance, xform,
                 )
@@ -994,10 +1017,13 @@ impl Scene {
                 Some(if n.dot(n_geo) < 0.0 { -n } else { n })
             })
             .unwrap_or(n_geo);
-        let uv = mesh
-            .uvs()
-            .map(|uvs| (0..3).map(|k| uvs[vertices[k] as usize] * b[k]).sum())
-            .unwrap_or(Vec2::new(tri.b1, tri.b2));
+        let uv = if !self.uv {
+            Vec2::ZERO
+        } else {
+            mesh.uvs()
+                .map(|uvs| (0..3).map(|k| uvs[vertices[k] as usize] * b[k]).sum())
+                .unwrap_or(Vec2::new(tri.b1, tri.b2))
+        };
         Hit {
             t: tri.t,
             p: Point3::from_glam(p),

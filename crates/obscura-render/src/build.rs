@@ -64,7 +64,8 @@ impl RenderScene {
         let default_index = materials.len() as u32;
         materials.push(DEFAULT_MATERIAL);
 
-        let mut builder = SceneBuilder::new();
+        // No material or output reads a hit's surface coordinates.
+        let mut builder = SceneBuilder::new().with_uv(false);
         let mut instance_material = Vec::new();
         let mut emitters = Vec::new();
         let mut meshes: HashMap<PathBuf, Arc<TriangleMesh>> = HashMap::new();

@@ -3,8 +3,9 @@
 use crate::reference::{
     Rng, TestScene, check_ray, random_placement, random_ray, random_shape, triangle_soup,
 };
-use obscura_accel::{Hit, Placement, Shape, TriangleMesh, load_obj};
+use obscura_accel::{Hit, Placement, SceneBuilder, Shape, TriangleMesh, load_obj};
 use obscura_space::Transform;
+use obscura_space::glam::Vec2;
 use proptest::prelude::*;
 use std::fmt::Write as _;
 use std::sync::Arc;
@@ -115,6 +116,25 @@ proptest! {
         for _ in 0..400 {
             let ray = random_ray(&mut rng);
             check_ray(&scene, &ray).map_err(TestCaseError::fail)?;
+        }
+    }
+
+    /// A scene built without surface coordinates answers every query as the same scene with
+    /// them, except that each hit's `uv` is zero.
+    #[test]
+    fn a_scene_without_uv_hits_the_same_with_zero_uv(seed in any::<u64>()) {
+        let test = random_scene(seed, 0.3);
+        let mut builder = SceneBuilder::new().with_uv(false);
+        for (shape, placement) in &test.instances {
+            builder.add(shape.clone(), placement.clone()).unwrap();
+        }
+        let without = builder.build().unwrap();
+        let mut rng = Rng(seed ^ 0x0f0f);
+        for _ in 0..200 {
+            let ray = random_ray(&mut rng);
+            let with = test.scene.intersect(&ray);
+            prop_assert_eq!(without.intersect(&ray), with.map(|h| Hit { uv: Vec2::ZERO, ..h }));
+            prop_assert_eq!(without.occluded(&ray), test.scene.occluded(&ray));
         }
     }
 
