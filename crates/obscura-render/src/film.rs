@@ -391,12 +391,16 @@ impl Film {
     /// Adds a tile's sums. Merge tiles in a fixed order for bit-identical results.
     pub fn merge(&mut self, tile: &TileBuffer) {
         let t = tile.rect;
-        for y in t.y0..t.y1 {
-            for x in t.x0..t.x1 {
-                let src = &tile.sums[((y - t.y0) * t.width() + (x - t.x0)) as usize];
-                let dst =
-                    ((y - self.bounds.y0) * self.bounds.width() + (x - self.bounds.x0)) as usize;
-                let d = &mut self.sums[dst];
+        let (width, film_width) = (t.width() as usize, self.bounds.width() as usize);
+        if width == 0 {
+            return;
+        }
+        // Row by row: one slice of each per row, no index arithmetic per pixel.
+        let first =
+            (t.y0 - self.bounds.y0) as usize * film_width + (t.x0 - self.bounds.x0) as usize;
+        for (j, src_row) in tile.sums.chunks_exact(width).enumerate() {
+            let start = first + j * film_width;
+            for (d, src) in self.sums[start..start + width].iter_mut().zip(src_row) {
                 let [r, g, b, w] = src.weighted.to_array().map(f64::from);
                 d.radiance[0] += r;
                 d.radiance[1] += g;
