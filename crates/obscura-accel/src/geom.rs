@@ -107,32 +107,62 @@ pub(crate) struct QuadHit {
     pub v: f32,
 }
 
-/// Ray against the parallelogram `origin + s * edge_u + v * edge_v`, `s, v` in `[0, 1]`.
-#[inline]
-pub(crate) fn intersect_quad(
-    ray_origin: Vec3,
-    direction: Vec3,
-    t_min: f32,
-    t_max: f32,
-    origin: Vec3,
-    edge_u: Vec3,
-    edge_v: Vec3,
-) -> Option<QuadHit> {
-    let n = edge_u.cross(edge_v);
-    let denom = n.dot(direction);
-    if denom == 0.0 || !denom.is_finite() {
-        return None;
+/// The parallelogram `origin + s * edge_u + v * edge_v`, `s, v` in `[0, 1]`, with its plane's
+/// normal `edge_u x edge_v` and that normal's squared length computed once, for the many rays
+/// a scene's quad meets (the same arithmetic as computing them per ray, so the same hits).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Parallelogram {
+    pub origin: Vec3,
+    pub edge_u: Vec3,
+    pub edge_v: Vec3,
+    /// `edge_u x edge_v` (not normalised).
+    pub n: Vec3,
+    /// `|n|^2`.
+    nn: f32,
+}
+
+impl Parallelogram {
+    pub(crate) fn new(origin: Vec3, edge_u: Vec3, edge_v: Vec3) -> Parallelogram {
+        let n = edge_u.cross(edge_v);
+        Parallelogram {
+            origin,
+            edge_u,
+            edge_v,
+            n,
+            nn: n.length_squared(),
+        }
     }
-    let t = n.dot(origin - ray_origin) / denom;
-    if !(t >= t_min && t <= t_max) {
-        return None;
+
+    /// The ray's hit with `t` in `[t_min, t_max]`, if any.
+    #[inline]
+    pub(crate) fn intersect(
+        &self,
+        ray_origin: Vec3,
+        direction: Vec3,
+        t_min: f32,
+        t_max: f32,
+    ) -> Option<QuadHit> {
+        let Parallelogram {
+            origin,
+            edge_u,
+            edge_v,
+            n,
+            nn,
+        } = *self;
+        let denom = n.dot(direction);
+        if denom == 0.0 || !denom.is_finite() {
+            return None;
+        }
+        let t = n.dot(origin - ray_origin) / denom;
+        if !(t >= t_min && t <= t_max) {
+            return None;
+        }
+        // w = s eu + v ev, so w x ev = s n and eu x w = v n.
+        let w = ray_origin + direction * t - origin;
+        let s = n.dot(w.cross(edge_v)) / nn;
+        let v = n.dot(edge_u.cross(w)) / nn;
+        ((0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&v)).then_some(QuadHit { t, s, v })
     }
-    // w = s eu + v ev, so w x ev = s n and eu x w = v n.
-    let w = ray_origin + direction * t - origin;
-    let nn = n.length_squared();
-    let s = n.dot(w.cross(edge_v)) / nn;
-    let v = n.dot(edge_u.cross(w)) / nn;
-    ((0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&v)).then_some(QuadHit { t, s, v })
 }
 
 /// Maps a point with an absolute error bound through an affine matrix, growing the bound by
@@ -274,16 +304,19 @@ mod tests {
     fn quad_hit_exact() {
         // The quad (0,0,0) + s (2,0,0) + v (0,4,0); the ray from (1, 1, 3) along -z meets z = 0
         // at t = 3, at x = 1 (s = 1/2) and y = 1 (v = 1/4).
-        let hit = intersect_quad(
-            Vec3::new(1.0, 1.0, 3.0),
-            Vec3::new(0.0, 0.0, -1.0),
-            0.0,
-            f32::INFINITY,
+        let quad = Parallelogram::new(
             Vec3::ZERO,
             Vec3::new(2.0, 0.0, 0.0),
             Vec3::new(0.0, 4.0, 0.0),
-        )
-        .unwrap();
+        );
+        let hit = quad
+            .intersect(
+                Vec3::new(1.0, 1.0, 3.0),
+                Vec3::new(0.0, 0.0, -1.0),
+                0.0,
+                f32::INFINITY,
+            )
+            .unwrap();
         assert_eq!((hit.t, hit.s, hit.v), (3.0, 0.5, 0.25));
     }
 

@@ -3,7 +3,7 @@
 use crate::error::AccelError;
 
 use crate::geom::{
-    QuadHit, TriangleHit, gamma, intersect_quad, intersect_sphere, object_space_error,
+    Parallelogram, QuadHit, TriangleHit, gamma, intersect_sphere, object_space_error,
     transform_point_with_error,
 };
 use crate::hit::Hit;
@@ -298,11 +298,7 @@ impl SceneBuilder {
                     item_bounds.push(xform.bounds(b));
                     items.push(Item::Analytic {
                         instance,
-                        shape: Analytic::Quad {
-                            origin,
-                            edge_u,
-                            edge_v,
-                        },
+                        shape: Analytic::Quad(Parallelogram::new(origin, edge_u, edge_v)),
                         xform,
                     });
                 }
@@ -450,15 +446,8 @@ impl Xform {
 
 #[derive(Debug, Clone, Copy)]
 enum Analytic {
-    Sphere {
-        center: Vec3,
-        radius: f32,
-    },
-    Quad {
-        origin: Vec3,
-        edge_u: Vec3,
-        edge_v: Vec3,
-    },
+    Sphere { center: Vec3, radius: f32 },
+    Quad(Parallelogram),
 }
 
 #[derive(Debug)]
@@ -796,12 +785,8 @@ impl Scene {
                         let t = intersect_sphere(o, d, r.t_min, t_max, center, radius)?;
                         Some(Found::Sphere { item, t })
                     }
-                    Analytic::Quad {
-                        origin,
-                        edge_u,
-                        edge_v,
-                    } => {
-                        let quad = intersect_quad(o, d, r.t_min, t_max, origin, edge_u, edge_v)?;
+                    Analytic::Quad(parallelogram) => {
+                        let quad = parallelogram.intersect(o, d, r.t_min, t_max)?;
                         Some(Found::Quad { item, quad })
                     }
                 }
@@ -923,18 +908,20 @@ impl Scene {
             }
             Found::Quad { item, quad } => {
                 let (instance, shape, xform) = self.analytic(item);
-                let Analytic::Quad {
+                let Analytic::Quad(Parallelogram {
                     origin,
                     edge_u,
                     edge_v,
-                } = shape
+                    n,
+                    ..
+                }) = shape
                 else {
                     unreachable!("Found::Quad comes from a quad")
                 };
                 let (su, sv) = (edge_u * quad.s, edge_v * quad.v);
                 let p_object = origin + su + sv;
                 let err_object = gamma(5) * (origin.abs() + su.abs() + sv.abs());
-                let n_object = edge_u.cross(edge_v);
+                let n_object = n;
                 let uv = if self.uv {
                     Vec2::new(quad.s, quad.v)
                 } else {
