@@ -152,14 +152,15 @@ def mitsuba_worker(variant, threads):
     import numpy as np
 
     times = []
-    # Two runs: the first llvm run includes JIT compilation, reported apart from the second.
-    for seed in range(2):
+    # The first llvm run includes JIT compilation and is reported apart; then the best of three,
+    # as Obscura's figure is the best of three runs.
+    for seed in range(4):
         start = time.perf_counter()
         image = mi.render(scene, spp=RENDER["spp"], seed=seed)
         mean = float(np.array(image).mean())  # forces evaluation in every variant
         times.append(time.perf_counter() - start)
     assert mean > 0.0, "Mitsuba rendered a black image"
-    print(json.dumps({"first_s": times[0], "best_s": times[1], "mean": mean}))
+    print(json.dumps({"first_s": times[0], "best_s": min(times[1:]), "mean": mean}))
 
 
 # --- orchestration -------------------------------------------------------------------------------
