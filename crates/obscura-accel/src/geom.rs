@@ -112,8 +112,11 @@ pub(crate) struct QuadHit {
 /// a scene's quad meets (the same arithmetic as computing them per ray, so the same hits).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Parallelogram {
+    /// The corner at `s = v = 0`.
     pub origin: Vec3,
+    /// The edge along which `s` runs.
     pub edge_u: Vec3,
+    /// The edge along which `v` runs.
     pub edge_v: Vec3,
     /// `edge_u x edge_v` (not normalised).
     pub n: Vec3,
@@ -122,6 +125,7 @@ pub(crate) struct Parallelogram {
 }
 
 impl Parallelogram {
+    /// The parallelogram at `origin` spanned by `edge_u` and `edge_v`.
     pub(crate) fn new(origin: Vec3, edge_u: Vec3, edge_v: Vec3) -> Parallelogram {
         let n = edge_u.cross(edge_v);
         Parallelogram {
