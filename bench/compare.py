@@ -19,7 +19,8 @@ honoured), then in this one invocation on this one machine:
 * render: `obscura render scenes/spheres-perspective.toml` at 512x512, 16 spp (as shipped, with
   its Sobol sampler, and again with the independent sampler Mitsuba uses), and the same scene
   written for Mitsuba 3 (`scalar_rgb`, and `llvm_ad_rgb` where libLLVM >= 15 loads), on 1 and
-  2 threads (each peer run in its own process pinned to that many cores).
+  2 threads (each peer run in its own process pinned to that many cores). Mitsuba's path
+  tracer gets Obscura's depth and Russian-roulette start, so both trace the same paths.
 
 Prints one table with the ratios (Obscura / peer for throughput, peer / Obscura for time: above
 1.0 means Obscura is faster) and writes all figures as JSON to bench/results.json.
@@ -28,6 +29,7 @@ Prints one table with the ratios (Obscura / peer for throughput, peer / Obscura 
 import argparse
 import json
 import os
+import re
 import subprocess
 import sys
 import time
@@ -37,7 +39,19 @@ ROOT = Path(__file__).resolve().parent.parent
 TARGET = Path(os.environ.get("CARGO_TARGET_DIR", ROOT / "target"))
 SCRATCH = Path(os.environ.get("OBSCURA_BENCH_DIR", "/tmp/obscura-bench"))
 MESHES = [("icosphere", 6), ("icosphere", 8), ("grid", 224), ("grid", 724)]
-RENDER = dict(resolution=512, spp=16, max_depth=6)
+
+
+def rr_start_depth():
+    """The bounce after which Obscura's path tracer starts Russian roulette, read from its
+    source (`PathIntegrator::RR_START_DEPTH`) so Mitsuba's `rr_depth` follows it."""
+    source = (ROOT / "crates" / "obscura-shade" / "src" / "integrator.rs").read_text()
+    found = re.search(r"const RR_START_DEPTH: u32 = (\d+);", source)
+    if not found:
+        raise SystemExit("compare.py: RR_START_DEPTH not found in obscura-shade's integrator")
+    return int(found.group(1))
+
+
+RENDER = dict(resolution=512, spp=16, max_depth=6, rr_depth=rr_start_depth())
 # Each side of the BVH comparison runs this many times, alternating with the other, and keeps
 # its best figure per measure: this machine's noise only ever slows a run down, and a single
 # run of either side swung by 10-20% between invocations.
@@ -99,8 +113,16 @@ def mitsuba_scene_dict(mi):
     return {
         "type": "scene",
         # Obscura's max_depth counts bounces after the camera ray; Mitsuba's counts path
-        # vertices including the emitter, so it is one more for the same paths.
-        "integrator": {"type": "path", "max_depth": RENDER["max_depth"] + 1},
+        # vertices including the emitter, so it is one more for the same paths. Both count
+        # bounces alike for Russian roulette, which Obscura starts after three
+        # (PathIntegrator::RR_START_DEPTH) and Mitsuba after rr_depth (default 5): the same
+        # start, so neither traces bounces the other ends (before round 8 Mitsuba did, and
+        # took 2.5% (scalar) to 8% (llvm) longer for it).
+        "integrator": {
+            "type": "path",
+            "max_depth": RENDER["max_depth"] + 1,
+            "rr_depth": RENDER["rr_depth"],
+        },
         "sensor": {
             "type": "perspective",
             "fov": 40.0,
@@ -390,23 +412,31 @@ def main():
     SCRATCH.mkdir(parents=True, exist_ok=True)
     if not args.no_build:
         cargo_build()
-    print(f"machine: {os.cpu_count()} CPUs, {platform_cpu()}; load {os.getloadavg()}")
+    machine = platform_cpu()
+    print(f"machine: {os.cpu_count()} CPUs, {machine}; load {os.getloadavg()}")
     # Both Embree and Obscura ask for huge pages for a large BVH; the kernel grants them only
     # when this says [always] or [madvise].
     print(f"transparent huge pages: {transparent_huge_pages()}")
     # A partial run (--only) replaces its own parts of results.json and keeps the others.
     saved = ROOT / "bench" / "results.json"
     results = json.loads(saved.read_text()) if saved.exists() else {}
-    results["cpu"] = platform_cpu()
+    results.pop("cpu", None)  # before round 8: one CPU for the whole file, whatever part ran
     results["transparent_huge_pages"] = transparent_huge_pages()
+    # Each part records the machine it ran on: a partial run replaces one part, and the peers'
+    # speed depends on the host's vector ISA (llvm_ad_rgb runs 16 lanes with AVX-512, 8 with
+    # AVX2), so figures from different hosts must not be read as one run.
+    machines = results.setdefault("machines", {})
     if args.only in (None, "accel"):
         results["accel"] = []
+        machines["accel"] = machine
         bench_accel(results)
     if args.only in (None, "render"):
         results["render"] = []
+        machines["render"] = machine
         bench_render(results)
     if args.only in (None, "scaling"):
         results.setdefault("accel", [])
+        machines["scaling"] = machine
         bench_scaling(results)
     saved.write_text(json.dumps(results, indent=2))
 
@@ -419,13 +449,25 @@ def transparent_huge_pages():
 
 
 def platform_cpu():
+    """The CPU as /proc/cpuinfo names it, with its family and model (a virtual machine's model
+    name may say only "AMD EPYC") and the widest vector instructions it has."""
+    fields = {}
     try:
         for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
+            key, _, value = line.partition(":")
+            fields.setdefault(key.strip(), value.strip())
     except OSError:
-        pass
-    return "unknown CPU"
+        return "unknown CPU"
+    flags = set(fields.get("flags", "").split())
+    isa = next((name for flag, name in VECTOR_ISAS if flag in flags), "SSE2")
+    return (
+        f"{fields.get('model name', 'unknown CPU')} (family {fields.get('cpu family', '?')} "
+        f"model {fields.get('model', '?')}, {isa})"
+    )
+
+
+# The widest vector extension first.
+VECTOR_ISAS = [("avx512f", "AVX-512"), ("avx2", "AVX2"), ("avx", "AVX"), ("sse4_2", "SSE4.2")]
 
 
 if __name__ == "__main__":
