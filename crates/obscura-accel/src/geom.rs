@@ -10,7 +10,7 @@ use glam::{Mat4, Vec3};
 /// pbrt's `gamma(n) = n * eps / (1 - n * eps)`, with `eps` half an ulp of 1: a bound on the
 /// relative error of `n` chained roundings.
 #[inline]
-pub(crate) fn gamma(n: i32) -> f32 {
+pub(crate) const fn gamma(n: i32) -> f32 {
     let eps = f32::EPSILON * 0.5;
     (n as f32 * eps) / (1.0 - n as f32 * eps)
 }
