@@ -420,7 +420,6 @@ def main():
     # A partial run (--only) replaces its own parts of results.json and keeps the others.
     saved = ROOT / "bench" / "results.json"
     results = json.loads(saved.read_text()) if saved.exists() else {}
-    results.pop("cpu", None)  # before round 8: one CPU for the whole file, whatever part ran
     results["transparent_huge_pages"] = transparent_huge_pages()
     # Each part records the machine it ran on: a partial run replaces one part, and the peers'
     # speed depends on the host's vector ISA (llvm_ad_rgb runs 16 lanes with AVX-512, 8 with
@@ -448,6 +447,10 @@ def transparent_huge_pages():
         return "unknown"
 
 
+# /proc/cpuinfo's flags of the vector extensions, widest first, with the names printed.
+VECTOR_ISAS = [("avx512f", "AVX-512"), ("avx2", "AVX2"), ("avx", "AVX"), ("sse4_2", "SSE4.2")]
+
+
 def platform_cpu():
     """The CPU as /proc/cpuinfo names it, with its family and model (a virtual machine's model
     name may say only "AMD EPYC") and the widest vector instructions it has."""
@@ -465,9 +468,6 @@ def platform_cpu():
         f"model {fields.get('model', '?')}, {isa})"
     )
 
-
-# The widest vector extension first.
-VECTOR_ISAS = [("avx512f", "AVX-512"), ("avx2", "AVX2"), ("avx", "AVX"), ("sse4_2", "SSE4.2")]
 
 
 if __name__ == "__main__":

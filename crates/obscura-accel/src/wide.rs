@@ -1030,11 +1030,14 @@ mod tests {
                 let n = h.e1.cross(h.e2).normalize();
                 let scale = h.v0.abs() + (h.e1 * h.tri.b1).abs() + (h.e2 * h.tri.b2).abs();
                 let off_plane = n.dot(p - h.v0).abs();
-                assert!(off_plane <= 8.0 * f32::EPSILON * scale.length(), "ray {k}");
+                assert!(
+                    off_plane <= 8.0 * f32::EPSILON * scale.length(),
+                    "ray {k}, t_min {t_min}"
+                );
                 let q = Vec3::from(o + dir * h.tri.t);
                 assert!(
                     (p - q).length() <= 1e-3 * q.length().max(1.0),
-                    "ray {k}: {p} vs {q}"
+                    "ray {k}, t_min {t_min}: {p} vs {q}"
                 );
             }
             other => panic!("ray {k}, t_min {t_min}: brute force and BVH disagree: {other:?}"),
