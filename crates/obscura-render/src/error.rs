@@ -1,15 +1,15 @@
 //! The renderer's one error type.
 
-use std::fmt;
 use std::path::PathBuf;
 
 /// Why a scene could not be loaded or rendered, or an image not written.
 ///
 /// Every message stands alone on one line: it names the file, and where known the key and line,
 /// e.g. `scenes/dof.toml:14: camera.fov: must be in (0, 180) degrees, got 180`.
-#[derive(Debug)]
+#[derive(Debug, thiserror::Error)]
 pub enum RenderError {
     /// The scene file (or a file it names) is wrong.
+    #[error("{}", located(file, *line, key.as_deref(), message))]
     Scene {
         /// The file at fault.
         file: PathBuf,
@@ -21,15 +21,18 @@ pub enum RenderError {
         message: String,
     },
     /// A file could not be read or written.
+    #[error("{}: {action}: {source}", file.display())]
     Io {
         /// The file.
         file: PathBuf,
         /// What was being done, e.g. "cannot read".
         action: &'static str,
         /// The operating system's error.
+        #[source]
         source: std::io::Error,
     },
     /// The image could not be encoded.
+    #[error("{}: {message}", file.display())]
     Encode {
         /// The output file.
         file: PathBuf,
@@ -37,6 +40,7 @@ pub enum RenderError {
         message: String,
     },
     /// A checkpoint file is corrupt, truncated, or belongs to another render.
+    #[error("{}: checkpoint: {message}", file.display())]
     Checkpoint {
         /// The checkpoint file.
         file: PathBuf,
@@ -44,6 +48,7 @@ pub enum RenderError {
         message: String,
     },
     /// A render setting from the command line is invalid.
+    #[error("{name}: {message}")]
     Setting {
         /// The setting, e.g. `--spp`.
         name: &'static str,
@@ -72,45 +77,19 @@ impl RenderError {
     }
 }
 
-impl fmt::Display for RenderError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            RenderError::Scene {
-                file,
-                line,
-                key,
-                message,
-            } => {
-                write!(f, "{}", file.display())?;
-                if let Some(line) = line {
-                    write!(f, ":{line}")?;
-                }
-                if let Some(key) = key {
-                    write!(f, ": {key}")?;
-                }
-                write!(f, ": {message}")
-            }
-            RenderError::Io {
-                file,
-                action,
-                source,
-            } => {
-                write!(f, "{}: {action}: {source}", file.display())
-            }
-            RenderError::Encode { file, message } => write!(f, "{}: {message}", file.display()),
-            RenderError::Checkpoint { file, message } => {
-                write!(f, "{}: checkpoint: {message}", file.display())
-            }
-            RenderError::Setting { name, message } => write!(f, "{name}: {message}"),
-        }
+/// `file[:line][: key]: message`, the one-line form of a scene error.
+fn located(
+    file: &std::path::Path,
+    line: Option<usize>,
+    key: Option<&str>,
+    message: &str,
+) -> String {
+    let mut out = file.display().to_string();
+    if let Some(line) = line {
+        out += &format!(":{line}");
     }
-}
-
-impl std::error::Error for RenderError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match self {
-            RenderError::Io { source, .. } => Some(source),
-            _ => None,
-        }
+    if let Some(key) = key {
+        out += &format!(": {key}");
     }
+    out + ": " + message
 }
