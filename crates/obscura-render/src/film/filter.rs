@@ -102,7 +102,7 @@ pub(super) const SPAN: usize = 8;
 /// `e^x` in four lanes, for `x <= 0` (the Gaussian's exponents): within one ulp of the
 /// correctly rounded value over a dense sweep of `[-87, 0]` (the tests allow two), `e^-87`
 /// below that and 1 above 0. Four lanes of SSE arithmetic instead of four calls into libm's
-/// `expf`, which were a quarter of a splat's instructions.
+/// `expf`.
 ///
 /// Cody and Waite's reduction: `x = n ln 2 + r` with `n` the nearest integer to `x / ln 2`, so
 /// `|r| <= ln 2 / 2`; `ln 2` is split into a high part with few enough bits that `n` times it
