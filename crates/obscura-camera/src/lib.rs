@@ -59,9 +59,15 @@
 
 mod any;
 mod camera;
+mod chain;
+mod cube_face;
+mod cylindrical;
 mod environment;
 mod error;
 mod film;
+mod fisheye;
+mod octahedral;
+mod ods;
 mod orthographic;
 mod perspective;
 mod projective;
@@ -71,9 +77,14 @@ pub use camera::{
     Camera, CameraBase, CameraRay, CameraRayDifferential, CameraSample, DEFAULT_FAR, DEFAULT_NEAR,
     LookAt, ThinLens, look_at_pose,
 };
+pub use cube_face::{CubeFace, CubeFaceCamera};
+pub use cylindrical::CylindricalCamera;
 pub use environment::EnvironmentCamera;
 pub use error::CameraError;
 pub use film::{FilmGeometry, FovAxis, MAX_RESOLUTION, ScreenWindow, Shutter};
+pub use fisheye::{FisheyeCamera, FisheyeProjection};
+pub use octahedral::OctahedralCamera;
+pub use ods::{OdsCamera, OdsEye};
 pub use orthographic::OrthographicCamera;
 pub use perspective::PerspectiveCamera;
 pub use projective::ProjectiveCamera;
