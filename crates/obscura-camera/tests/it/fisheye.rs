@@ -261,17 +261,20 @@ proptest! {
                 "{back:?} vs {p:?} (tol {tol})");
         } else {
             // (The back pole projects onto the rim, which f32 rounding may put just outside:
-            // step 1e-5 of the radius inwards, 3e-5 rad.)
+            // step inwards by e pixels, 1e-5 of the radius plus a few f32 steps of the
+            // raster coordinates.)
+            let e = 1e-5 * radius + 4e-7 * (centre.x.abs() + centre.y.abs() + radius);
+            let k = 1.0 - e / radius;
             let inward = Point2::new(
-                centre.x + (back.x - centre.x) * (1.0 - 1e-5),
-                centre.y + (back.y - centre.y) * (1.0 - 1e-5),
+                centre.x + (back.x - centre.x) * k,
+                centre.y + (back.y - centre.y) * k,
             );
             let again = camera.generate_ray(&CameraSample::at(inward)).unwrap().ray;
-            // The raster error e (that step plus f32 rounding of raster positions) is an angle
-            // error e / f for equidistant; for equisolid, whose r = 2 f sin(theta / 2) is flat
-            // at theta = pi (r = 2 f - f (pi - theta)^2 / 4), it is 2 sqrt(e / f).
+            // The raster error 2 e (that step plus f32 rounding of raster positions) is an
+            // angle error 2 e / f for equidistant; for equisolid, whose r = 2 f sin(theta / 2)
+            // is flat at theta = pi (r = 2 f - f (pi - theta)^2 / 4), it is 2 sqrt(2 e / f).
             let f = camera.focal_length() as f32;
-            let e = 1e-5 * radius + 2e-7 * (centre.x.abs() + centre.y.abs() + radius);
+            let e = 2.0 * e;
             let tol = 1e-3 + match camera.projection() {
                 FisheyeProjection::Equisolid => 2.0 * (e / f).sqrt(),
                 _ => e / f,
