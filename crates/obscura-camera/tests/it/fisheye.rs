@@ -52,7 +52,7 @@ fn angle_against_radius_hand_computed() {
     let cases = [
         (FisheyeProjection::Equidistant, 180.0, 45.0),
         (FisheyeProjection::Equisolid, 180.0, 41.409_622),
-        (FisheyeProjection::Stereographic, 180.0, 53.130_10),
+        (FisheyeProjection::Stereographic, 180.0, 53.130_1),
         (FisheyeProjection::Orthographic, 120.0, 25.658_906),
     ];
     for (projection, fov, theta) in cases {
@@ -308,7 +308,7 @@ proptest! {
 
     /// Differentials are the neighbouring rays, inside the circle and at its rim.
     #[test]
-    fn differentials(camera in fisheye_strategy(), rho in prop_oneof![Just(1.0f32), 0f32..1.0], psi in 0f32..6.28) {
+    fn differentials(camera in fisheye_strategy(), rho in prop_oneof![Just(1.0f32), 0f32..1.0], psi in 0f32..std::f32::consts::TAU) {
         let (centre, radius) = camera.image_circle();
         let p = Point2::new(centre.x + rho * radius * psi.cos(), centre.y - rho * radius * psi.sin());
         check_neighbours(&camera, p);
