@@ -18,10 +18,11 @@ pub enum OdsEye {
 }
 
 /// An omni-directional stereo panorama for VR, after Google's "Rendering Omni-directional
-/// Stereo Content" (Google Inc., 2015): the image's top half is the left eye's panorama, the
-/// bottom half the right eye's, each an equirectangular `W x H/2` image with the environment
-/// camera's mapping (SCENE_FORMAT.md). For raster `(x, y)`, the eye's own row
-/// `y' = y` (left, `y < H/2`) or `y - H/2` (right), and `r = interaxial / 2`:
+/// Stereo Content" (Google Inc., the white paper accompanying its Jump VR cameras): the image's
+/// top half is the left eye's panorama, the bottom half the right eye's, each an
+/// equirectangular `W x H/2` image with the environment camera's mapping (SCENE_FORMAT.md).
+/// For raster `(x, y)`, the eye's own row `y' = y` (left, `y < H/2`) or `y - H/2` (right),
+/// and `r = interaxial / 2`:
 ///
 /// `phi = 2 pi (x / W - 0.5)` (azimuth from camera +z towards +x),
 /// `theta = pi y' / (H / 2)` (polar angle from camera +y),
@@ -32,8 +33,9 @@ pub enum OdsEye {
 /// plane (`y = 0`) and is tangent to it (`o . d = 0`): the eyes of a head turned towards azimuth
 /// `phi`, the left one on the head's left (looking along +z, the left eye sits at `(-r, 0, 0)`,
 /// camera -x being the image's left). Google's document writes this in an OpenGL frame
-/// (forward -z); with Obscura's forward +z, its `(cos theta, 0, sin theta) * scale` origin, left
-/// `scale = -ipd / 2`, becomes the `o` above. The radius is kept constant up to the poles, as in
+/// (forward -z, its `theta` our `phi`); with Obscura's forward +z, its origin
+/// `(cos theta, 0, sin theta) * scale`, `scale = -ipd / 2` for the left eye, becomes the `o`
+/// above (POV-Ray's ODS camera in its left-handed frame, the same as Obscura's, reads the same). The radius is kept constant up to the poles, as in
 /// the document's basic form. Rays are clipped by distance from their origin,
 /// `[t_min, t_max] = [near, far]`; `interaxial = 0` gives two copies of the environment
 /// camera's panorama.
