@@ -102,9 +102,9 @@ impl FromStr for CubeFace {
 
 /// One face of a cube map: a 90-degree perspective camera looking along the face's axis, in
 /// the OpenGL cube-map orientation (OpenGL 4.6 core specification, section 8.13 "Cube Map
-/// Texture Selection", the table "Selection of cube map images"). The cube's frame is the camera frame (+x right, +y up,
-/// +z forward), so the `+z` face is the camera's forward view, exactly what a 90-degree
-/// perspective camera of the same pose sees, and `-z` looks back.
+/// Texture Selection", the table "Selection of cube map images"). The cube's frame is the
+/// camera frame (+x right, +y up, +z forward), so the `+z` face is the camera's forward view,
+/// exactly what a 90-degree perspective camera of the same pose sees, and `-z` looks back.
 ///
 /// For a direction `r`, the table gives the major axis `ma` and the face coordinates `sc`,
 /// `tc`:

@@ -35,10 +35,10 @@ pub enum OdsEye {
 /// camera -x being the image's left). Google's document writes this in an OpenGL frame
 /// (forward -z, its `theta` our `phi`); with Obscura's forward +z, its origin
 /// `(cos theta, 0, sin theta) * scale`, `scale = -ipd / 2` for the left eye, becomes the `o`
-/// above (POV-Ray's ODS camera in its left-handed frame, the same as Obscura's, reads the same). The radius is kept constant up to the poles, as in
-/// the document's basic form. Rays are clipped by distance from their origin,
-/// `[t_min, t_max] = [near, far]`; `interaxial = 0` gives two copies of the environment
-/// camera's panorama.
+/// above (POV-Ray's ODS camera in its left-handed frame, the same as Obscura's, reads the
+/// same). The radius is kept constant up to the poles, as in the document's basic form. Rays
+/// are clipped by distance from their origin, `[t_min, t_max] = [near, far]`;
+/// `interaxial = 0` gives two copies of the environment camera's panorama.
 ///
 /// [`Camera::project`] gives the left eye's image of a point (use [`OdsCamera::project_eye`]
 /// for the right's): the tangent from the point to the circle on that eye's side. A point
