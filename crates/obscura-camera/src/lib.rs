@@ -12,6 +12,11 @@
 //! transforms (`screen_from_camera`, `raster_from_screen`, `camera_from_raster`...). Errors are
 //! [`CameraError`].
 //!
+//! Beyond the lecture: the ideal fisheyes [`FisheyeCamera`] ([`FisheyeProjection`]), the
+//! panoramas [`CylindricalCamera`], [`OctahedralCamera`] (equal-area) and [`CubeFaceCamera`]
+//! ([`CubeFace`]), and the omni-directional stereo panorama [`OdsCamera`]; each doc comment
+//! gives its formulas, its source and the film points from which no ray leaves.
+//!
 //! What is not here: films with pixels, filters, samplers, scene files, geometry. This crate
 //! knows nothing of BVHs, images or files; it depends on `obscura-space`, `obscura-sample`
 //! (for the aperture warps) and glam.
