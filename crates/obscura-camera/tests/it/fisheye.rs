@@ -332,3 +332,77 @@ fn differentials_against_finite_differences() {
         }
     }
 }
+
+/// At the rim, a neighbour outside the circle is the reflection of the opposite neighbour
+/// through the main ray: rx = normalize(2 d(p) - d(p - (1, 0))).
+#[test]
+fn differential_at_the_rim_reflects_the_inner_neighbour() {
+    let camera = fisheye(
+        [200, 200],
+        FisheyeProjection::Equidistant,
+        180.0,
+        [0.0, 0.0],
+    );
+    // The rim's right end (200, 100): the neighbour (201, 100) is outside.
+    let p = Point2::new(200.0, 100.0);
+    assert!(
+        camera
+            .generate_ray(&CameraSample::at(Point2::new(201.0, 100.0)))
+            .is_none()
+    );
+    let diff = camera
+        .generate_ray_differential(&CameraSample::at(p))
+        .unwrap();
+    let d = camera
+        .generate_ray(&CameraSample::at(p))
+        .unwrap()
+        .ray
+        .direction
+        .to_glam();
+    let inner = camera
+        .generate_ray(&CameraSample::at(Point2::new(199.0, 100.0)))
+        .unwrap()
+        .ray
+        .direction
+        .to_glam();
+    assert_close3(
+        diff.rx_direction.to_glam(),
+        (2.0 * d - inner).normalize(),
+        1e-6,
+    );
+    // Theta steps by 1 / f = pi / 200 per pixel: the reflected step is the same size.
+    let step = diff.rx_direction.to_glam().angle_between(d);
+    assert!((step - std::f32::consts::PI / 200.0).abs() < 1e-4, "{step}");
+}
+
+/// A moving camera: the ray of time sample u starts at the eye of time u (shutter [0, 1]).
+#[test]
+fn moving_pose_is_evaluated_at_the_ray_time() {
+    let shutter = obscura_camera::Shutter::new(0.0, 1.0).unwrap();
+    let start = identity_look();
+    let end = (
+        obscura_space::Point3::new(2.0, 0.0, 0.0),
+        obscura_space::Point3::new(2.0, 0.0, -1.0),
+        start.2,
+    );
+    let base = obscura_camera::CameraBase::new(
+        obscura_camera::look_at_pose(start, Some(end), shutter).unwrap(),
+        shutter,
+        obscura_camera::FilmGeometry::new([64, 64], None, None).unwrap(),
+    );
+    let camera = FisheyeCamera::new(base, FisheyeProjection::Equisolid, 200.0, [0.0, 0.0]).unwrap();
+    let sample = CameraSample {
+        time: 0.25,
+        ..CameraSample::at(Point2::new(32.0, 32.0))
+    };
+    let ray = camera.generate_ray(&sample).unwrap().ray;
+    assert_eq!(ray.time, 0.25);
+    assert_close3(ray.origin.to_glam(), glam::Vec3::new(0.5, 0.0, 0.0), 1e-6);
+    assert_close3(
+        ray.direction.to_glam(),
+        glam::Vec3::new(0.0, 0.0, -1.0),
+        1e-6,
+    );
+    let diff = camera.generate_ray_differential(&sample).unwrap();
+    assert_eq!(diff.ray, ray);
+}

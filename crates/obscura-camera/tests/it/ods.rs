@@ -224,3 +224,43 @@ fn differentials_against_finite_differences() {
         });
     }
 }
+
+/// Every new model dispatches through `AnyCamera` unchanged.
+#[test]
+fn any_camera_dispatch() {
+    use obscura_camera::{
+        AnyCamera, CubeFace, CubeFaceCamera, CylindricalCamera, FisheyeCamera, FisheyeProjection,
+        OctahedralCamera,
+    };
+    let base = || base_at(identity_look(), [32, 32], None, 0.0, 1.0e30);
+    let cameras: [AnyCamera; 5] = [
+        FisheyeCamera::new(base(), FisheyeProjection::Stereographic, 200.0, [0.0, 0.0])
+            .unwrap()
+            .into(),
+        CylindricalCamera::new(base(), 90.0).unwrap().into(),
+        OctahedralCamera::new(base()).unwrap().into(),
+        CubeFaceCamera::new(base(), CubeFace::NegativeY)
+            .unwrap()
+            .into(),
+        OdsCamera::new(base(), 0.064).unwrap().into(),
+    ];
+    let sample = CameraSample::at(Point2::new(11.5, 7.25));
+    let direct = [
+        FisheyeCamera::new(base(), FisheyeProjection::Stereographic, 200.0, [0.0, 0.0])
+            .unwrap()
+            .generate_ray(&sample),
+        CylindricalCamera::new(base(), 90.0)
+            .unwrap()
+            .generate_ray(&sample),
+        OctahedralCamera::new(base()).unwrap().generate_ray(&sample),
+        CubeFaceCamera::new(base(), CubeFace::NegativeY)
+            .unwrap()
+            .generate_ray(&sample),
+        OdsCamera::new(base(), 0.064).unwrap().generate_ray(&sample),
+    ];
+    for (camera, direct) in cameras.iter().zip(direct) {
+        assert_eq!(camera.generate_ray(&sample), direct);
+        assert!(!camera.uses_lens_sample());
+        assert!(camera.uses_time_sample());
+    }
+}
