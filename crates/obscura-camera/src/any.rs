@@ -1,8 +1,13 @@
 //! The closed set of camera models as one enum.
 
 use crate::camera::{Camera, CameraRay, CameraRayDifferential, CameraSample};
+use crate::cube_face::CubeFaceCamera;
+use crate::cylindrical::CylindricalCamera;
 use crate::environment::EnvironmentCamera;
 use crate::film::{FilmGeometry, Shutter};
+use crate::fisheye::FisheyeCamera;
+use crate::octahedral::OctahedralCamera;
+use crate::ods::OdsCamera;
 use crate::orthographic::OrthographicCamera;
 use crate::perspective::PerspectiveCamera;
 use obscura_space::{AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, World};
@@ -16,6 +21,16 @@ pub enum AnyCamera {
     Orthographic(OrthographicCamera),
     /// An environment camera.
     Environment(EnvironmentCamera),
+    /// An ideal fisheye camera.
+    Fisheye(FisheyeCamera),
+    /// A cylindrical panorama camera.
+    Cylindrical(CylindricalCamera),
+    /// An equal-area octahedral panorama camera.
+    Octahedral(OctahedralCamera),
+    /// One face of a cube map.
+    CubeFace(CubeFaceCamera),
+    /// An omni-directional stereo panorama camera.
+    Ods(OdsCamera),
 }
 
 macro_rules! dispatch {
@@ -24,6 +39,11 @@ macro_rules! dispatch {
             AnyCamera::Perspective($c) => $e,
             AnyCamera::Orthographic($c) => $e,
             AnyCamera::Environment($c) => $e,
+            AnyCamera::Fisheye($c) => $e,
+            AnyCamera::Cylindrical($c) => $e,
+            AnyCamera::Octahedral($c) => $e,
+            AnyCamera::CubeFace($c) => $e,
+            AnyCamera::Ods($c) => $e,
         }
     };
 }
@@ -76,5 +96,30 @@ impl From<OrthographicCamera> for AnyCamera {
 impl From<EnvironmentCamera> for AnyCamera {
     fn from(c: EnvironmentCamera) -> Self {
         AnyCamera::Environment(c)
+    }
+}
+impl From<FisheyeCamera> for AnyCamera {
+    fn from(c: FisheyeCamera) -> Self {
+        AnyCamera::Fisheye(c)
+    }
+}
+impl From<CylindricalCamera> for AnyCamera {
+    fn from(c: CylindricalCamera) -> Self {
+        AnyCamera::Cylindrical(c)
+    }
+}
+impl From<OctahedralCamera> for AnyCamera {
+    fn from(c: OctahedralCamera) -> Self {
+        AnyCamera::Octahedral(c)
+    }
+}
+impl From<CubeFaceCamera> for AnyCamera {
+    fn from(c: CubeFaceCamera) -> Self {
+        AnyCamera::CubeFace(c)
+    }
+}
+impl From<OdsCamera> for AnyCamera {
+    fn from(c: OdsCamera) -> Self {
+        AnyCamera::Ods(c)
     }
 }

@@ -80,6 +80,36 @@ pub enum CameraError {
     },
     /// The camera pose could not be built (a degenerate look-at, mirrored keyframes...).
     Pose(SpaceError),
+    /// An unknown fisheye `projection` name.
+    UnknownFisheyeProjection(String),
+    /// A fisheye field of view outside its projection's range.
+    FisheyeFov {
+        /// The projection's scene name, e.g. `"orthographic"`.
+        projection: &'static str,
+        /// The largest field of view the projection allows, in degrees.
+        max: f32,
+        /// Whether `max` itself is allowed.
+        max_inclusive: bool,
+        /// The value given, in degrees.
+        got: f32,
+    },
+    /// An unknown cube-map `face` name.
+    UnknownCubeFace(String),
+    /// A film whose shape the camera model cannot use (a non-square octahedral or cube-face
+    /// film, an ODS film of odd height).
+    FilmShape {
+        /// The camera model's scene name, e.g. `"octahedral"`.
+        model: &'static str,
+        /// What the model needs, e.g. `"a square"`.
+        need: &'static str,
+        /// The resolution given, width then height.
+        got: [u32; 2],
+    },
+    /// A negative ODS `interaxial` distance.
+    Interaxial {
+        /// The value given.
+        got: f32,
+    },
 }
 
 impl fmt::Display for CameraError {
@@ -149,6 +179,33 @@ impl fmt::Display for CameraError {
                 "shutter must be finite with open <= close, got [{open}, {close}]"
             ),
             CameraError::Pose(e) => write!(f, "camera pose: {e}"),
+            CameraError::UnknownFisheyeProjection(name) => write!(
+                f,
+                "projection must be one of \"equidistant\", \"equisolid\", \"stereographic\", \
+                 \"orthographic\", got {name:?}"
+            ),
+            CameraError::FisheyeFov {
+                projection,
+                max,
+                max_inclusive,
+                got,
+            } => write!(
+                f,
+                "fov of a {projection} fisheye must be in (0, {max}{} degrees, got {got}",
+                if *max_inclusive { "]" } else { ")" }
+            ),
+            CameraError::UnknownCubeFace(name) => write!(
+                f,
+                "face must be one of \"+x\", \"-x\", \"+y\", \"-y\", \"+z\", \"-z\", got {name:?}"
+            ),
+            CameraError::FilmShape { model, need, got } => write!(
+                f,
+                "a {model} camera needs {need} film, got {} x {}",
+                got[0], got[1]
+            ),
+            CameraError::Interaxial { got } => {
+                write!(f, "interaxial must be >= 0, got {got}")
+            }
         }
     }
 }

@@ -12,6 +12,11 @@
 //! transforms (`screen_from_camera`, `raster_from_screen`, `camera_from_raster`...). Errors are
 //! [`CameraError`].
 //!
+//! Beyond the lecture: the ideal fisheyes [`FisheyeCamera`] ([`FisheyeProjection`]), the
+//! panoramas [`CylindricalCamera`], [`OctahedralCamera`] (equal-area) and [`CubeFaceCamera`]
+//! ([`CubeFace`]), and the omni-directional stereo panorama [`OdsCamera`]; each doc comment
+//! gives its formulas, its source and the film points from which no ray leaves.
+//!
 //! What is not here: films with pixels, filters, samplers, scene files, geometry. This crate
 //! knows nothing of BVHs, images or files; it depends on `obscura-space`, `obscura-sample`
 //! (for the aperture warps) and glam.
@@ -59,9 +64,15 @@
 
 mod any;
 mod camera;
+mod chain;
+mod cube_face;
+mod cylindrical;
 mod environment;
 mod error;
 mod film;
+mod fisheye;
+mod octahedral;
+mod ods;
 mod orthographic;
 mod perspective;
 mod projective;
@@ -71,9 +82,14 @@ pub use camera::{
     Camera, CameraBase, CameraRay, CameraRayDifferential, CameraSample, DEFAULT_FAR, DEFAULT_NEAR,
     LookAt, ThinLens, look_at_pose,
 };
+pub use cube_face::{CubeFace, CubeFaceCamera};
+pub use cylindrical::CylindricalCamera;
 pub use environment::EnvironmentCamera;
 pub use error::CameraError;
 pub use film::{FilmGeometry, FovAxis, MAX_RESOLUTION, ScreenWindow, Shutter};
+pub use fisheye::{FisheyeCamera, FisheyeProjection};
+pub use octahedral::OctahedralCamera;
+pub use ods::{OdsCamera, OdsEye};
 pub use orthographic::OrthographicCamera;
 pub use perspective::PerspectiveCamera;
 pub use projective::ProjectiveCamera;

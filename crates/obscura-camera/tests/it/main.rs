@@ -7,10 +7,16 @@
 //! rounds to within ~1e-3 pixel; 2e-3 pixel still catches any real error (a flipped axis or a
 //! half-pixel shift moves results by >= 0.5). Directions are compared within 1e-5.
 
+mod cube_face;
+mod cylindrical;
 mod environment;
 mod exact;
+mod fisheye;
 mod motion;
+mod octahedral;
+mod ods;
 mod projective;
+mod ray_checks;
 mod sample_use;
 mod thin_lens;
 mod validation;
