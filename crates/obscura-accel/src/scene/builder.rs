@@ -64,19 +64,19 @@ impl SceneBuilder {
         self
     }
 
-    /// Whether hits carry surface coordinates ([`Hit::uv`]; on by default). Off, every hit's
-    /// `uv` is zero and costs nothing: a sphere's takes an arccosine and an arctangent, a
-    /// mesh's a read of its uv array (on a large mesh, one more cache miss per hit). For
-    /// callers that read no textures, such as Obscura's own renderer.
-    /// [`PreliminaryHit::primitive_uv`] is not affected.
+    /// Whether hits carry surface coordinates ([`Hit::uv`](crate::Hit::uv); on by default).
+    /// Off, every hit's `uv` is zero and costs nothing: a sphere's takes an arccosine and an
+    /// arctangent, a mesh's a read of its uv array (on a large mesh, one more cache miss per
+    /// hit). For callers that read no textures, such as Obscura's own renderer.
+    /// [`PreliminaryHit::primitive_uv`](crate::PreliminaryHit::primitive_uv) is not affected.
     pub fn with_uv(mut self, uv: bool) -> Self {
         self.no_uv = !uv;
         self
     }
 
     /// Adds an instance. Returns the instance index (0, 1, 2... in call order):
-    /// [`Hit::instance`] reports it. Errors for invalid shape parameters (non-finite values, a
-    /// radius <= 0, a quad of zero area) or a non-finite placement.
+    /// [`Hit::instance`](crate::Hit::instance) reports it. Errors for invalid shape parameters
+    /// (non-finite values, a radius <= 0, a quad of zero area) or a non-finite placement.
     pub fn add(&mut self, shape: Shape, placement: Placement) -> Result<u32, AccelError> {
         match &shape {
             Shape::Mesh(_) => {}
