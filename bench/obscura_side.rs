@@ -7,13 +7,19 @@
 //! preliminary hit: distance, ids and barycentrics, what `rtcIntersect1` returns) and of
 //! occlusion, and prints one JSON object on stdout. Run by hand, never by the test suite.
 
-use camera_obscura::accel::{Placement, Scene, SceneBuilder, Shape, TriangleMesh, testmesh};
+use camera_obscura::accel::{Placement, Scene, SceneBuilder, Shape, TriangleMesh};
 use camera_obscura::space::{Point3, Ray, Transform, Vector3, World};
 use std::hint::black_box;
 use std::io::Write;
 use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
+
+// obscura-accel's generated meshes (test and benchmark code, not its API); the ray sets in
+// the same file are not used on this side.
+#[allow(dead_code)]
+#[path = "../crates/obscura-accel/tests/it/testmesh.rs"]
+mod testmesh;
 
 /// Rays per set: a 256 x 256 pinhole grid, and as many incoherent rays.
 const SIDE: usize = 256;

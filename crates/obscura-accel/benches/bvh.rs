@@ -10,10 +10,14 @@
 #![allow(missing_docs)]
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use obscura_accel::{Placement, Scene, SceneBuilder, Shape, testmesh};
+use obscura_accel::{Placement, Scene, SceneBuilder, Shape};
 use obscura_space::Transform;
 use std::hint::black_box;
 use std::sync::Arc;
+
+// Generated meshes and ray sets, shared with the tests (not part of obscura-accel's API).
+#[path = "../tests/it/testmesh.rs"]
+mod testmesh;
 
 /// Icospheres of 20 * 4^6 = 81,920 and 20 * 4^8 = 1,310,720 triangles, and displaced grids of
 /// 2 * 224^2 = 100,352 and 2 * 724^2 = 1,048,352 triangles.

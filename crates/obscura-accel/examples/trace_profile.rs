@@ -18,10 +18,14 @@
 //! (`grid` for the default), and `fast`, `medium` (the default) or `slow` as the second for the
 //! [`BuildQuality`].
 
-use obscura_accel::{BuildQuality, Placement, Scene, SceneBuilder, Shape, testmesh};
+use obscura_accel::{BuildQuality, Placement, Scene, SceneBuilder, Shape};
 use obscura_space::{Ray, Transform, World};
 use std::hint::black_box;
 use std::sync::Arc;
+
+// Generated meshes and ray sets, shared with the tests (not part of obscura-accel's API).
+#[path = "../tests/it/testmesh.rs"]
+mod testmesh;
 
 #[inline(never)]
 fn closest_primary(scene: &Scene, rays: &[Ray<World>]) -> f64 {

@@ -1,13 +1,13 @@
 //! The crate's one error type.
 
-use core::fmt;
 use std::path::PathBuf;
 
 /// Why a mesh, an OBJ file, a shape or a scene was refused. Every message stands alone: it
 /// names the file and, where known, the line.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum AccelError {
     /// The OBJ file could not be opened or read.
+    #[error("{}: cannot read the OBJ file: {reason}", path.display())]
     Io {
         /// The file.
         path: PathBuf,
@@ -15,6 +15,7 @@ pub enum AccelError {
         reason: String,
     },
     /// The OBJ file is malformed.
+    #[error("{}: {}{reason}", path.display(), line_prefix(*line))]
     Obj {
         /// The file.
         path: PathBuf,
@@ -24,11 +25,19 @@ pub enum AccelError {
         reason: String,
     },
     /// A mesh given in memory is invalid (non-finite position, index out of range, ...).
+    #[error("triangle mesh: {0}")]
     Mesh(String),
     /// A shape's parameters are invalid (non-finite, zero radius, degenerate quad, ...).
+    #[error("shape: {0}")]
     Shape(String),
     /// A placement (instance transform) is invalid.
+    #[error("instance placement: {0}")]
     Placement(String),
+}
+
+/// `"line N: "` where the line is known, else nothing.
+fn line_prefix(line: Option<usize>) -> String {
+    line.map_or(String::new(), |line| format!("line {line}: "))
 }
 
 impl AccelError {
@@ -44,28 +53,3 @@ impl AccelError {
         }
     }
 }
-
-impl fmt::Display for AccelError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            AccelError::Io { path, reason } => {
-                write!(f, "{}: cannot read the OBJ file: {reason}", path.display())
-            }
-            AccelError::Obj {
-                path,
-                line: Some(line),
-                reason,
-            } => write!(f, "{}: line {line}: {reason}", path.display()),
-            AccelError::Obj {
-                path,
-                line: None,
-                reason,
-            } => write!(f, "{}: {reason}", path.display()),
-            AccelError::Mesh(reason) => write!(f, "triangle mesh: {reason}"),
-            AccelError::Shape(reason) => write!(f, "shape: {reason}"),
-            AccelError::Placement(reason) => write!(f, "instance placement: {reason}"),
-        }
-    }
-}
-
-impl std::error::Error for AccelError {}

@@ -18,7 +18,6 @@
 //! - Hits: [`Hit`] carries the world-space point with a conservative error bound, and
 //!   [`Hit::spawn_ray`] / [`Hit::spawn_ray_to`] offset new rays by that bound (pbrt's method), so
 //!   a surface does not shadow itself.
-//! - [`testmesh`]: generated meshes (geodesic sphere, displaced grid) for tests and benchmarks.
 //!
 //! The decision to know: visibility is decided at the ray's own time. Static meshes are
 //! flattened into world space once and share one BVH; a moving instance is bounded in the top
@@ -60,13 +59,12 @@ mod mesh;
 mod obj;
 mod pages;
 mod scene;
-pub mod testmesh;
+mod shape;
 mod wide;
 
 pub use error::AccelError;
 pub use hit::{Hit, SHADOW_EPSILON};
 pub use mesh::TriangleMesh;
 pub use obj::{load_obj, parse_obj};
-pub use scene::{
-    BuildQuality, MAX_COORDINATE, Placement, PreliminaryHit, Scene, SceneBuilder, Shape,
-};
+pub use scene::{BuildQuality, MAX_COORDINATE, PreliminaryHit, Scene, SceneBuilder};
+pub use shape::{Placement, Shape};

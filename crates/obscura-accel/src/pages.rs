@@ -6,9 +6,8 @@
 //! paging).
 //! Linux backs memory with 2 MiB pages where the mapping asks for them (`madvise` with
 //! `MADV_HUGEPAGE`; Embree asks for its BVH too), but the allocator behind `Vec` does not ask.
-//! [`Pages`] moves a finished array into an anonymous mapping that does: on the 1M-triangle
-//! benchmark meshes that is 6-26% more incoherent rays per second (docs/performance.md,
-//! round 4).
+//! [`Pages`] moves a finished array into an anonymous mapping that does (the gain on the
+//! benchmark meshes is in docs/performance.md).
 //!
 //! Arrays under [`Pages::MIN_BYTES`], and every array on systems other than Linux, or where the
 //! mapping fails, stay in their `Vec`: the pages are a speed-up, never a requirement.

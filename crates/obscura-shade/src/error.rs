@@ -1,17 +1,17 @@
 //! The one error type of this crate.
 
-use core::fmt;
-
 /// Why a material, light or shading scene was rejected. Every message names the parameter and
 /// stands alone, so the renderer can print it after the scene file's name and key.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ShadeError {
     /// A parameter holds NaN or infinity.
+    #[error("{parameter} must be finite (no NaN or infinity)")]
     NotFinite {
         /// The parameter's name, e.g. `"reflectance"`.
         parameter: &'static str,
     },
     /// A parameter lies outside its allowed range.
+    #[error("{parameter} must be {expected}")]
     OutOfRange {
         /// The parameter's name, e.g. `"ior"`.
         parameter: &'static str,
@@ -19,6 +19,7 @@ pub enum ShadeError {
         expected: &'static str,
     },
     /// An environment map's texel count does not match its size.
+    #[error("environment map texels: expected width * height = {expected}, got {actual}")]
     TexelCount {
         /// `width * height`.
         expected: u64,
@@ -26,6 +27,7 @@ pub enum ShadeError {
         actual: usize,
     },
     /// An index refers to something that does not exist.
+    #[error("{what} = {index} is out of range (there are {count})")]
     BadIndex {
         /// What the index is, e.g. `"instance_material[3]"`.
         what: String,
@@ -35,29 +37,6 @@ pub enum ShadeError {
         count: usize,
     },
 }
-
-impl fmt::Display for ShadeError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            ShadeError::NotFinite { parameter } => {
-                write!(f, "{parameter} must be finite (no NaN or infinity)")
-            }
-            ShadeError::OutOfRange {
-                parameter,
-                expected,
-            } => write!(f, "{parameter} must be {expected}"),
-            ShadeError::TexelCount { expected, actual } => write!(
-                f,
-                "environment map texels: expected width * height = {expected}, got {actual}"
-            ),
-            ShadeError::BadIndex { what, index, count } => {
-                write!(f, "{what} = {index} is out of range (there are {count})")
-            }
-        }
-    }
-}
-
-impl std::error::Error for ShadeError {}
 
 /// Checks that every component of `v` is finite and at least zero.
 pub(crate) fn check_non_negative(v: glam::Vec3, parameter: &'static str) -> Result<(), ShadeError> {

@@ -6,3 +6,4 @@ mod exact;
 mod obj_files;
 mod reference;
 mod spawn;
+mod testmesh;

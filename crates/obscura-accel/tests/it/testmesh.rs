@@ -1,4 +1,5 @@
-//! Meshes generated in code, for benchmarks, tests and examples.
+//! Meshes generated in code, for obscura-accel's tests, benchmarks and profiling example (not
+//! part of the crate's API: each of them includes this file with `#[path]`).
 //!
 //! - [`icosphere`]: a geodesic sphere of radius 1 at the origin, `20 * 4^n` triangles
 //!   (n = 6: 81,920; n = 7: 327,680; n = 8: 1,310,720), with smooth per-vertex normals.
@@ -8,9 +9,8 @@
 //! - [`primary_rays`] and [`random_rays`]: the coherent and incoherent ray sets the benchmarks
 //!   and profiling examples trace at these meshes.
 
-use crate::error::AccelError;
-use crate::mesh::TriangleMesh;
-use glam::{Vec2, Vec3};
+use obscura_accel::{AccelError, TriangleMesh};
+use obscura_space::glam::{Vec2, Vec3};
 use obscura_space::{Point3, Ray, Vector3, World};
 use std::collections::HashMap;
 
@@ -171,12 +171,13 @@ pub fn random_rays() -> Vec<Ray<World>> {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    // Paths through `super::` rather than a glob import: a benchmark that includes this file
+    // compiles the module without its tests, where the import would be unused.
 
     #[test]
     fn icosphere_counts_and_orientation() {
         for n in 0..3 {
-            let mesh = icosphere(n).unwrap();
+            let mesh = super::icosphere(n).unwrap();
             // Each subdivision splits every triangle in four; Euler: V = T / 2 + 2.
             assert_eq!(mesh.triangle_count(), 20 * 4usize.pow(n));
             assert_eq!(mesh.positions().len(), mesh.triangle_count() / 2 + 2);
@@ -187,14 +188,41 @@ mod tests {
                 assert!((b - a).cross(c - a).dot(a + b + c) > 0.0);
             }
         }
-        assert!(icosphere(MAX_ICOSPHERE_SUBDIVISIONS + 1).is_err());
+        assert!(super::icosphere(super::MAX_ICOSPHERE_SUBDIVISIONS + 1).is_err());
     }
 
     #[test]
     fn grid_counts() {
-        let mesh = displaced_grid(3).unwrap();
+        let mesh = super::displaced_grid(3).unwrap();
         assert_eq!(mesh.triangle_count(), 18);
         assert_eq!(mesh.positions().len(), 16);
-        assert!(displaced_grid(0).is_err());
+        assert!(super::displaced_grid(0).is_err());
+    }
+
+    #[test]
+    fn ray_sets_are_unit_rays_aimed_as_documented() {
+        let (primary, random) = (super::primary_rays(), super::random_rays());
+        assert_eq!((primary.len(), random.len()), (256 * 256, 65_536));
+        for ray in primary.iter().chain(&random) {
+            let d = ray.direction.to_glam();
+            assert!((d.length() - 1.0).abs() < 1e-5, "{d}");
+        }
+        // Primary rays: from (0, 0, 3), within 30 degrees of -z along each image axis.
+        let half = 30.0f32.to_radians().tan();
+        for ray in &primary {
+            let (o, d) = (ray.origin.to_glam(), ray.direction.to_glam());
+            assert_eq!(o, super::Vec3::new(0.0, 0.0, 3.0));
+            assert!(d.z < 0.0 && (d.x / -d.z).abs() <= half && (d.y / -d.z).abs() <= half);
+        }
+        // Random rays: from radius 3 towards the unit cube, so they pass within its
+        // circumscribed sphere (radius sqrt(3)).
+        for ray in &random {
+            let (o, d) = (ray.origin.to_glam(), ray.direction.to_glam());
+            assert!((o.length() - 3.0).abs() < 1e-4, "{o}");
+            assert!(
+                (o - d * o.dot(d)).length() <= 3.0f32.sqrt() + 1e-4,
+                "{o} {d}"
+            );
+        }
     }
 }

@@ -1,0 +1,187 @@
+//! The scene: instances of shapes under their placements, the two-level BVH over them, and the
+//! ray queries. `builder.rs` makes a [`Scene`], `query.rs` answers rays, `record.rs` builds the
+//! full [`Hit`](crate::Hit) from what a query found.
+
+mod builder;
+mod query;
+mod record;
+
+pub use builder::{BuildQuality, MAX_COORDINATE, SceneBuilder};
+pub use query::PreliminaryHit;
+
+use crate::geom::{Parallelogram, QuadHit};
+use crate::mesh::TriangleMesh;
+use crate::wide::{BoxSet, WideBvh, WideHit};
+use glam::{Vec3, Vec3A};
+use obscura_space::{AnimatedTransform, Bounds3, Object, Ray, Transform, World};
+use obvhs::cwbvh::CwBvh;
+use std::sync::Arc;
+
+/// A built scene, ready for ray queries from any number of threads.
+#[derive(Debug)]
+pub struct Scene {
+    items: Vec<Item>,
+    /// How rays find the items.
+    tlas: Top,
+    /// All static mesh triangles in world space; hits carry (triangle, instance).
+    flat: Option<WideBvh>,
+    /// One object-space BVH per distinct moving mesh.
+    blases: Vec<WideBvh>,
+    meshes: Vec<Option<Arc<TriangleMesh>>>,
+    statics: Vec<Option<Transform<World, Object>>>,
+    bounds: Bounds3<World>,
+    /// Whether an item moves (see [`Scene::moves`]), found once at build time.
+    moves: bool,
+    /// Whether hits carry their surface coordinates ([`SceneBuilder::with_uv`]).
+    uv: bool,
+}
+
+/// The top level of a [`Scene`].
+#[derive(Debug)]
+enum Top {
+    /// Zero or one item: no top level.
+    One,
+    /// A few items, their boxes tested at once. `sorted`: a closest-hit query visits the
+    /// boxes entered nearest first (when an item is a mesh, whose BVH query the best hit so
+    /// far prunes); otherwise in index order, which for a few spheres and quads costs less
+    /// than the sort.
+    Few { set: BoxSet, sorted: bool },
+    /// obvhs's tree over the items, with its slot -> item map.
+    Tree(CwBvh, Vec<u32>),
+}
+
+#[derive(Debug, Clone)]
+enum Xform {
+    /// Object space is world space: rays need no transform.
+    Identity,
+    Static(Transform<World, Object>),
+    Moving(AnimatedTransform<World, Object>),
+}
+
+impl Xform {
+    #[inline]
+    fn at(&self, time: f32) -> Transform<World, Object> {
+        match self {
+            Xform::Identity => Transform::IDENTITY,
+            Xform::Static(t) => *t,
+            Xform::Moving(a) => a.at(time),
+        }
+    }
+    /// The ray's origin and direction in object space at the ray's time.
+    #[inline]
+    fn ray_to_object(&self, r: &PlainRay) -> (Vec3A, Vec3A) {
+        match self {
+            Xform::Identity => (r.o, r.d),
+            _ => to_object(&self.at(r.time).inverse(), r),
+        }
+    }
+
+    fn bounds(&self, b: Bounds3<Object>) -> Bounds3<World> {
+        match self {
+            Xform::Identity => Transform::IDENTITY.bounds(b),
+            Xform::Static(t) => t.bounds(b),
+            Xform::Moving(a) => a.motion_bounds(b),
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy)]
+enum Analytic {
+    Sphere { center: Vec3, radius: f32 },
+    Quad(Parallelogram),
+}
+
+#[derive(Debug)]
+enum Item {
+    /// The flattened static triangles.
+    Flat,
+    Analytic {
+        instance: u32,
+        shape: Analytic,
+        xform: Xform,
+    },
+    MovingMesh {
+        instance: u32,
+        blas: usize,
+        world_from_object: AnimatedTransform<World, Object>,
+    },
+}
+
+/// What a traversal found, enough to build the [`Hit`] afterwards.
+#[derive(Clone, Copy, Debug)]
+enum Found {
+    /// A flattened triangle; the ids are (triangle, instance).
+    Flat {
+        hit: WideHit,
+    },
+    /// A triangle of a moving mesh, in object space; the first id is the triangle.
+    Moving {
+        item: usize,
+        hit: WideHit,
+    },
+    Sphere {
+        item: usize,
+        t: f32,
+    },
+    Quad {
+        item: usize,
+        quad: QuadHit,
+    },
+}
+
+impl Found {
+    fn t(&self) -> f32 {
+        match self {
+            Found::Flat { hit } | Found::Moving { hit, .. } => hit.tri.t,
+            Found::Sphere { t, .. } => *t,
+            Found::Quad { quad, .. } => quad.t,
+        }
+    }
+}
+
+/// A world ray as plain glam values, checked once.
+#[derive(Clone, Copy, Debug)]
+struct PlainRay {
+    o: Vec3A,
+    d: Vec3A,
+    time: f32,
+    t_min: f32,
+    t_max: f32,
+}
+
+impl PlainRay {
+    /// `None` for a ray that can hit nothing: non-finite or zero direction, NaN or empty range.
+    fn new(ray: &Ray<World>) -> Option<Self> {
+        let o = Vec3A::from(ray.origin.to_glam());
+        let d = Vec3A::from(ray.direction.to_glam());
+        let ok = o.is_finite()
+            && d.is_finite()
+            && d != Vec3A::ZERO
+            && !ray.t_min.is_nan()
+            && !ray.t_max.is_nan()
+            && ray.t_min <= ray.t_max;
+        ok.then_some(PlainRay {
+            o,
+            d,
+            time: ray.time,
+            t_min: ray.t_min,
+            t_max: ray.t_max,
+        })
+    }
+}
+
+/// The ray's origin and direction carried into object space.
+#[inline]
+fn to_object(object_from_world: &Transform<Object, World>, r: &PlainRay) -> (Vec3A, Vec3A) {
+    let m = object_from_world.matrix();
+    (
+        Vec3A::from(m.transform_point3(Vec3::from(r.o))),
+        Vec3A::from(m.transform_vector3(Vec3::from(r.d))),
+    )
+}
+
+// The renderer shares one scene between its worker threads.
+const _: () = {
+    const fn assert_send_sync<T: Send + Sync>() {}
+    assert_send_sync::<Scene>();
+};

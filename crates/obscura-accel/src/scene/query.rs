@@ -1,0 +1,297 @@
+//! The ray queries: closest hit (full or preliminary) and any hit, through the top level into
+//! each item.
+
+use super::{Analytic, Found, Item, PlainRay, Scene, Top, to_object};
+use crate::geom::intersect_sphere;
+use crate::hit::Hit;
+use crate::wide::{BoxSet, WideBvh};
+use glam::{Vec2, Vec3};
+use obscura_space::{Bounds3, Ray, World};
+use obvhs::ray::RayHit;
+
+/// The closest hit a [`Scene::intersect_preliminary`] query found, before the full [`Hit`] is
+/// built: cheap to get (no mesh data is read) and turned into the `Hit` by
+/// [`complete`](PreliminaryHit::complete), exactly as [`Scene::intersect`] would have
+/// returned it. It borrows the scene, so it cannot be completed against another.
+#[derive(Clone, Copy, Debug)]
+pub struct PreliminaryHit<'a> {
+    scene: &'a Scene,
+    ray: PlainRay,
+    found: Found,
+}
+
+impl PreliminaryHit<'_> {
+    /// The ray parameter of the hit (as [`Hit::t`]).
+    pub fn t(&self) -> f32 {
+        self.found.t()
+    }
+
+    /// The instance hit (as [`Hit::instance`]).
+    pub fn instance(&self) -> u32 {
+        match self.found {
+            Found::Flat { hit } => hit.ids[1],
+            Found::Moving { item, .. } | Found::Sphere { item, .. } | Found::Quad { item, .. } => {
+                match &self.scene.items[item] {
+                    Item::Analytic { instance, .. } | Item::MovingMesh { instance, .. } => {
+                        *instance
+                    }
+                    Item::Flat => unreachable!("flattened triangles are found as Found::Flat"),
+                }
+            }
+        }
+    }
+
+    /// The triangle hit within its mesh, 0 for spheres and quads (as [`Hit::primitive`]).
+    pub fn primitive(&self) -> u32 {
+        match self.found {
+            Found::Flat { hit } | Found::Moving { hit, .. } => hit.ids[0],
+            Found::Sphere { .. } | Found::Quad { .. } => 0,
+        }
+    }
+
+    /// The primitive's own coordinates of the hit: for a triangle the barycentrics `(b1, b2)`
+    /// of its vertices 1 and 2, for a quad `(s, t)` along `edge_u` and `edge_v`; zero for a
+    /// sphere, whose coordinates need the hit point (see [`Hit::uv`]).
+    pub fn primitive_uv(&self) -> Vec2 {
+        match self.found {
+            Found::Flat { hit } | Found::Moving { hit, .. } => Vec2::new(hit.tri.b1, hit.tri.b2),
+            Found::Quad { quad, .. } => Vec2::new(quad.s, quad.v),
+            Found::Sphere { .. } => Vec2::ZERO,
+        }
+    }
+
+    /// The full hit record: point and error bound, normals, surface coordinates.
+    pub fn complete(&self) -> Hit {
+        self.scene.finish(&self.ray, self.found)
+    }
+}
+
+impl Scene {
+    /// The closest hit with `t` in `[t_min, t_max]`, moving instances placed at the ray's time.
+    /// `None` for a miss, and for rays that cannot hit anything (non-finite origin or
+    /// direction, zero direction, NaN or empty range).
+    ///
+    /// The same as [`intersect_preliminary`](Scene::intersect_preliminary) followed by
+    /// [`PreliminaryHit::complete`].
+    pub fn intersect(&self, ray: &Ray<World>) -> Option<Hit> {
+        // Written out rather than as `intersect_preliminary(ray)?.complete()`, so the hot path
+        // does not move a `PreliminaryHit` through (docs/performance.md).
+        let r = PlainRay::new(ray)?;
+        let found = self.found(&r)?;
+        Some(self.finish(&r, found))
+    }
+
+    /// The closest hit as [`intersect`](Scene::intersect) finds it, before its full record is
+    /// built: the distance, the instance and primitive, and the primitive's own coordinates,
+    /// with no mesh data read (the role of Embree's `rtcIntersect1` or Mitsuba's preliminary
+    /// intersection). For queries that need only what was hit and how far away (depth and id
+    /// buffers, lidar returns), and for deciding which hits deserve
+    /// [`complete`](PreliminaryHit::complete).
+    ///
+    /// ```
+    /// use obscura_accel::{Placement, SceneBuilder, Shape};
+    /// use obscura_space::{Point3, Ray, Transform, Vector3, World};
+    /// use obscura_space::glam::Vec3;
+    ///
+    /// let mut builder = SceneBuilder::new();
+    /// let quad = Shape::Quad {
+    ///     origin: Vec3::new(-1.0, -1.0, 0.0),
+    ///     edge_u: Vec3::new(2.0, 0.0, 0.0),
+    ///     edge_v: Vec3::new(0.0, 2.0, 0.0),
+    /// };
+    /// let id = builder.add(quad, Placement::Static(Transform::IDENTITY))?;
+    /// let scene = builder.build()?;
+    /// let ray = Ray::<World>::new(Point3::new(0.5, 0.0, 3.0), Vector3::new(0.0, 0.0, -1.0), 0.0);
+    /// let found = scene.intersect_preliminary(&ray).expect("the ray meets the quad");
+    /// assert_eq!((found.instance(), found.t()), (id, 3.0));
+    /// assert_eq!(found.primitive_uv().to_array(), [0.75, 0.5]);
+    /// assert_eq!(found.complete(), scene.intersect(&ray).unwrap());
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn intersect_preliminary(&self, ray: &Ray<World>) -> Option<PreliminaryHit<'_>> {
+        let r = PlainRay::new(ray)?;
+        let found = self.found(&r)?;
+        Some(PreliminaryHit {
+            scene: self,
+            ray: r,
+            found,
+        })
+    }
+
+    /// The closest hit on any item, before its record is built.
+    #[inline]
+    fn found(&self, r: &PlainRay) -> Option<Found> {
+        match &self.tlas {
+            Top::One if self.items.len() == 1 => self.intersect_item(0, r, r.t_max),
+            Top::One => None,
+            Top::Few { set, sorted: true } => {
+                let mut entered = [(0, 0.0); BoxSet::CAPACITY];
+                let n = set.entered(r.o, r.d, r.t_min, r.t_max, &mut entered);
+                // The best distance is kept beside the best hit, not read back from it: a
+                // `Found` is a 72-byte enum, and matching it for its `t` before every item
+                // would put a jump table and stack copies in the hottest loop of small scenes.
+                let mut best: Option<Found> = None;
+                let mut t_best = r.t_max;
+                for &(item, t_entry) in &entered[..n] {
+                    if t_entry > t_best {
+                        break;
+                    }
+                    if let Some(f) = self.intersect_item(item, r, t_best) {
+                        t_best = f.t();
+                        best = Some(f);
+                    }
+                }
+                best
+            }
+            Top::Few { set, sorted: false } => {
+                // Spheres and quads in index order: the sort (and the zeroed array it fills)
+                // costs more than the item tests it would spare (docs/performance.md). One
+                // entered beyond the best hit so far is still skipped.
+                let (t_near, mut mask) = set.test(r.o, r.d, r.t_min, r.t_max);
+                let mut best: Option<Found> = None;
+                let mut t_best = r.t_max;
+                while mask != 0 {
+                    let item = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    if t_near[item & 7] > t_best {
+                        continue;
+                    }
+                    if let Some(f) = self.intersect_item(item, r, t_best) {
+                        t_best = f.t();
+                        best = Some(f);
+                    }
+                }
+                best
+            }
+            Top::Tree(tlas, order) => {
+                let top = obvhs::ray::Ray::new(r.o, r.d, r.t_min, r.t_max);
+                let mut ray_hit = RayHit::none();
+                let mut best = None;
+                tlas.ray_traverse(top, &mut ray_hit, |top, slot| {
+                    match self.intersect_item(order[slot] as usize, r, top.tmax) {
+                        Some(f) => {
+                            best = Some(f);
+                            f.t()
+                        }
+                        None => f32::INFINITY,
+                    }
+                });
+                best
+            }
+        }
+    }
+
+    /// True when anything is hit with `t` in `[t_min, t_max]` (for shadow rays); stops at the
+    /// first hit found.
+    pub fn occluded(&self, ray: &Ray<World>) -> bool {
+        let Some(r) = PlainRay::new(ray) else {
+            return false;
+        };
+        match &self.tlas {
+            Top::One if self.items.len() == 1 => self.occluded_item(0, &r),
+            Top::One => false,
+            Top::Few { set, .. } => {
+                // Any order will do for a shadow ray.
+                let mut mask = set.entered_mask(r.o, r.d, r.t_min, r.t_max);
+                while mask != 0 {
+                    let item = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    if self.occluded_item(item, &r) {
+                        return true;
+                    }
+                }
+                false
+            }
+            Top::Tree(tlas, order) => {
+                let top = obvhs::ray::Ray::new(r.o, r.d, r.t_min, r.t_max);
+                !tlas.ray_traverse_miss(top, |_, slot| {
+                    if self.occluded_item(order[slot] as usize, &r) {
+                        f32::NEG_INFINITY
+                    } else {
+                        f32::INFINITY
+                    }
+                })
+            }
+        }
+    }
+
+    /// True when some instance moves (a placement given at shutter close): only then does a
+    /// ray's time change what it hits. Constant time (found at build), so a renderer may ask
+    /// per tile.
+    pub fn moves(&self) -> bool {
+        self.moves
+    }
+
+    /// The box of everything in the scene, over all times.
+    pub fn bounds(&self) -> Bounds3<World> {
+        self.bounds
+    }
+
+    /// The number of instances added.
+    pub fn instance_count(&self) -> usize {
+        self.meshes.len()
+    }
+
+    /// Bytes held by the triangle BVHs (nodes and leaf triangles; the meshes themselves and
+    /// the few-box top level are not counted), for memory budgets and the performance notes.
+    pub fn bvh_bytes(&self) -> usize {
+        let flat = self.flat.as_ref().map_or(0, WideBvh::heap_bytes);
+        flat + self.blases.iter().map(WideBvh::heap_bytes).sum::<usize>()
+    }
+
+    /// The closest hit on one item with `t` in `[r.t_min, t_max]`.
+    #[inline]
+    fn intersect_item(&self, item: usize, r: &PlainRay, t_max: f32) -> Option<Found> {
+        match &self.items[item] {
+            Item::Flat => {
+                let hit = self.flat.as_ref()?.closest(r.o, r.d, r.t_min, t_max)?;
+                Some(Found::Flat { hit })
+            }
+            Item::MovingMesh {
+                blas,
+                world_from_object,
+                ..
+            } => {
+                let object_from_world = world_from_object.at(r.time).inverse();
+                let (o, d) = to_object(&object_from_world, r);
+                let hit = self.blases[*blas].closest(o, d, r.t_min, t_max)?;
+                Some(Found::Moving { item, hit })
+            }
+            Item::Analytic { shape, xform, .. } => {
+                let (o, d) = xform.ray_to_object(r);
+                let (o, d) = (Vec3::from(o), Vec3::from(d));
+                match *shape {
+                    Analytic::Sphere { center, radius } => {
+                        let t = intersect_sphere(o, d, r.t_min, t_max, center, radius)?;
+                        Some(Found::Sphere { item, t })
+                    }
+                    Analytic::Quad(parallelogram) => {
+                        let quad = parallelogram.intersect(o, d, r.t_min, t_max)?;
+                        Some(Found::Quad { item, quad })
+                    }
+                }
+            }
+        }
+    }
+
+    /// True when one item is hit with `t` in `[r.t_min, r.t_max]`.
+    #[inline]
+    fn occluded_item(&self, item: usize, r: &PlainRay) -> bool {
+        match &self.items[item] {
+            Item::Flat => self
+                .flat
+                .as_ref()
+                .is_some_and(|blas| blas.any(r.o, r.d, r.t_min, r.t_max)),
+            Item::MovingMesh {
+                blas,
+                world_from_object,
+                ..
+            } => {
+                let object_from_world = world_from_object.at(r.time).inverse();
+                let (o, d) = to_object(&object_from_world, r);
+                self.blases[*blas].any(o, d, r.t_min, r.t_max)
+            }
+            Item::Analytic { .. } => self.intersect_item(item, r, r.t_max).is_some(),
+        }
+    }
+}

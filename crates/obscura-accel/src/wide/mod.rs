@@ -1,0 +1,73 @@
+//! The triangle BVH: obvhs builds the tree, this module lays it out for SIMD and traverses it.
+//!
+//! obvhs builds a binary BVH (PLOC, then reinsertion, with the [`BvhBuildParams`] preset); it is
+//! collapsed here into nodes of up to eight children whose boxes sit in structure-of-arrays
+//! form, one lane per child, so one ray tests eight boxes in two registers' worth of SSE
+//! instructions (the test is written over plain eight-lane arrays, which the compiler
+//! vectorises; a build for an AVX CPU gets one register). Leaves are *packets* of up to four
+//! triangles (their first vertices and edges, again one lane per triangle) tested together by
+//! a four-wide Möller–Trumbore. Which binary nodes become a wide node's children and which
+//! subtrees become packets is chosen by a surface-area dynamic programme over the whole binary
+//! tree (`Collapse::plan`).
+//!
+//! Why not obvhs's own traversal: its compressed wide BVH (CWBVH) unpacks eight quantised child
+//! boxes per node and tests leaf triangles one at a time (docs/performance.md has the profile).
+//! A traversal over a 1M-triangle mesh is bound by memory latency, one cache miss per node
+//! visited, so the wide nodes (half the depth of a four-wide tree) matter most; nodes and
+//! packets are aligned to cache lines so none straddles one line more than it must, and the
+//! children a ray will visit later are touched when stacked so their lines load in the
+//! meantime. Large arrays live on transparent huge pages ([`Pages`]), so the visits are not
+//! also TLB misses.
+//!
+//! The files: `layout.rs` (nodes and packets), `collapse.rs` (the build), `ray.rs` (the slab
+//! and triangle tests), `traverse.rs` (the queries), `boxset.rs` (a top level of few boxes).
+//!
+//! Everything is safe Rust: the lanes are glam's `Vec4` (an SSE register on x86-64) or arrays
+//! the compiler vectorises.
+
+mod boxset;
+mod collapse;
+mod layout;
+mod ray;
+mod traverse;
+
+pub(crate) use boxset::BoxSet;
+
+use crate::geom::TriangleHit;
+use crate::pages::Pages;
+use glam::Vec3;
+use layout::{Node, Packet};
+
+/// A hit found by [`WideBvh::closest`]: the triangle's ids and the triangle itself as the BVH
+/// stores it (first vertex and the two edges from it), so the caller needs no further lookup.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct WideHit {
+    /// The two ids given for the triangle at build time.
+    pub ids: [u32; 2],
+    /// Distance and barycentrics.
+    pub tri: TriangleHit,
+    /// `v0`, `v1 - v0`, `v2 - v0`, exactly as the intersection test used them.
+    pub v0: Vec3,
+    pub e1: Vec3,
+    pub e2: Vec3,
+}
+
+/// An eight-wide BVH with four-wide leaf packets over a list of triangles, its arrays on huge
+/// pages where they are large enough ([`Pages`]).
+#[derive(Clone, Debug)]
+pub(crate) struct WideBvh {
+    nodes: Pages<Node>,
+    packets: Pages<Packet>,
+    /// A node index, a leaf reference, or `EMPTY` for no triangles.
+    root: u32,
+}
+
+impl WideBvh {
+    /// Bytes held by the nodes and packets (for the memory figures).
+    pub(crate) fn heap_bytes(&self) -> usize {
+        self.nodes.bytes() + self.packets.bytes()
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,191 @@
+//! A ray prepared for the SIMD tests: the slab test of up to eight child boxes, and the
+//! four-wide triangle test of a leaf packet.
+
+use super::layout::{ARITY, Node, Packet, WIDTH};
+use crate::geom::gamma;
+use glam::{BVec4A, Vec3A, Vec4};
+
+/// pbrt's `gamma(3)`: the relative error of a slab distance `(b - o) * (1 / d)`; the far
+/// distance is pushed out by twice this so rounding never culls a box the ray touches.
+pub(super) const SLAB_SLACK: f32 = 2.0 * gamma(3);
+/// The same push folded into the far planes' reciprocals, `(b - o) * ((1 / d) * FAR_SCALE)`,
+/// for queries with `t_min >= 0`: the and, multiply and add of `t + |t| * SLAB_SLACK` stay out
+/// of every node's dependent chain, and unused lanes make no NaN. Four
+/// roundings then separate a computed far distance from the true one (`gamma(4)` below it)
+/// and three the near distance (`gamma(3)` above it), so a box the ray touches is kept when
+/// `FAR_SCALE * (1 - gamma(4)) >= 1 + gamma(3)`; `1 + 2 gamma(4)` is four ulps above one
+/// and clears it (`far_scale_covers_the_rounding` checks this in f64). A negative far
+/// distance would be pulled in, not pushed out, so a query that may start behind its origin
+/// keeps [`SLAB_SLACK`] instead.
+pub(super) const FAR_SCALE: f32 = 1.0 + 2.0 * gamma(4);
+
+/// A ray prepared for the box tests: splatted origin, reciprocal direction and near-plane lanes.
+/// `SLACK`: far distances get [`SLAB_SLACK`] after the fact (a query with `t_min < 0`);
+/// otherwise the far planes' reciprocals carry [`FAR_SCALE`]. Which one a query takes is
+/// decided once, so the traversal of each has no test for it per node.
+pub(super) struct Prepared<const SLACK: bool> {
+    o: [Vec4; 3],
+    d: [Vec4; 3],
+    inv: [f32; 3],
+    /// The far planes' reciprocals: `inv` times [`FAR_SCALE`], or `inv` itself with `SLACK`.
+    inv_far: [f32; 3],
+    /// 1 where the direction is negative (the box's max plane is met first), else 0.
+    near: [usize; 3],
+}
+
+impl<const SLACK: bool> Prepared<SLACK> {
+    /// The ray from `o` along `d`.
+    #[inline(always)]
+    pub(super) fn new(o: Vec3A, d: Vec3A) -> Self {
+        // A zero component would give 0 * inf = NaN on a slab through the origin; a tiny
+        // stand-in of the same sign gives the same slab answer with finite arithmetic.
+        // (Three lanes at once: one division instruction instead of three.)
+        let tiny = Vec3A::splat(1e-30);
+        let safe = Vec3A::select(d.abs().cmplt(tiny), tiny.copysign(d), d);
+        let inv = Vec3A::ONE / safe;
+        let inv_far = if SLACK { inv } else { inv * FAR_SCALE };
+        let inv = inv.to_array();
+        Prepared {
+            o: [Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z)],
+            d: [Vec4::splat(d.x), Vec4::splat(d.y), Vec4::splat(d.z)],
+            inv,
+            inv_far: inv_far.to_array(),
+            near: inv.map(|i| usize::from(i < 0.0)),
+        }
+    }
+
+    /// The entry distance of each of the node's first `N` children's boxes and the mask of
+    /// those the ray enters within `[t_min, t_max]` (`N` a multiple of four: eight for a BVH
+    /// node, four for a top level of few boxes). Written over plain arrays, which the compiler
+    /// vectorises: one SSE register per four lanes on baseline x86-64 (one AVX register for
+    /// eight when built for a CPU that has it). The `if`s are
+    /// `maxps`/`minps` exactly, NaN operands included.
+    #[inline(always)]
+    pub(super) fn slabs<const N: usize>(
+        &self,
+        node: &Node,
+        t_min: f32,
+        t_max: f32,
+    ) -> ([f32; N], u32) {
+        const { assert!(N.is_multiple_of(WIDTH) && N <= ARITY) };
+        #[inline(always)]
+        fn max(a: f32, b: f32) -> f32 {
+            if a > b { a } else { b }
+        }
+        #[inline(always)]
+        fn min(a: f32, b: f32) -> f32 {
+            if a < b { a } else { b }
+        }
+        let plane = |i: usize| -> &[f32; N] {
+            let lanes: &[f32; ARITY] = bytemuck::cast_ref(&node.bounds[i]);
+            lanes.first_chunk().expect("N <= ARITY")
+        };
+        let (nx, ny, nz) = (self.near[0] & 1, self.near[1] & 1, self.near[2] & 1);
+        let (near_x, far_x) = (plane(nx), plane(nx ^ 1));
+        let (near_y, far_y) = (plane(2 + ny), plane(2 + (ny ^ 1)));
+        let (near_z, far_z) = (plane(4 + nz), plane(4 + (nz ^ 1)));
+        let (o, inv, inv_far) = (self.o.map(|v| v.x), self.inv, self.inv_far);
+        let mut t_near = [0.0; N];
+        let mut t_far = [0.0; N];
+        for lane in 0..N {
+            let tnx = (near_x[lane] - o[0]) * inv[0];
+            let tfx = (far_x[lane] - o[0]) * inv_far[0];
+            let tny = (near_y[lane] - o[1]) * inv[1];
+            let tfy = (far_y[lane] - o[1]) * inv_far[1];
+            let tnz = (near_z[lane] - o[2]) * inv[2];
+            let tfz = (far_z[lane] - o[2]) * inv_far[2];
+            t_near[lane] = max(max(tnx, tny), max(tnz, t_min));
+            let t = min(min(tfx, tfy), tfz);
+            // An unused lane's near distance is +inf and its far distance -inf, so it is
+            // never entered. The slack makes -inf NaN; `t_max` goes first so that `minps`
+            // returns its second operand, NaN, which no entry distance is below.
+            t_far[lane] = min(t_max, if SLACK { t + t.abs() * SLAB_SLACK } else { t });
+        }
+        // The mask four lanes at a time: the compiler does not find `movmskps` in the loop.
+        let mut mask = 0;
+        for h in 0..N / WIDTH {
+            let near = Vec4::from_slice(&t_near[WIDTH * h..]);
+            mask |= near.cmple(Vec4::from_slice(&t_far[WIDTH * h..])).bitmask() << (WIDTH * h);
+        }
+        (t_near, mask)
+    }
+
+    /// The lanes of `p` the ray hits within `[t_min, t_max]`, with their distances and
+    /// barycentrics (Möller–Trumbore, four triangles at once).
+    #[inline(always)]
+    pub(super) fn triangles(&self, p: &Packet, t_min: f32, t_max: f32) -> (u32, Vec4, Vec4, Vec4) {
+        let [dx, dy, dz] = self.d;
+        let [e1x, e1y, e1z] = p.e1;
+        let [e2x, e2y, e2z] = p.e2;
+        // pvec = d x e2
+        let px = dy * e2z - dz * e2y;
+        let py = dz * e2x - dx * e2z;
+        let pz = dx * e2y - dy * e2x;
+        let det = e1x * px + e1y * py + e1z * pz;
+        let inv_det = Vec4::ONE / det;
+        // tvec = o - v0
+        let tx = self.o[0] - p.v0[0];
+        let ty = self.o[1] - p.v0[1];
+        let tz = self.o[2] - p.v0[2];
+        let b1 = (tx * px + ty * py + tz * pz) * inv_det;
+        // qvec = tvec x e1
+        let qx = ty * e1z - tz * e1y;
+        let qy = tz * e1x - tx * e1z;
+        let qz = tx * e1y - ty * e1x;
+        let b2 = (dx * qx + dy * qy + dz * qz) * inv_det;
+        let t = (e2x * qx + e2y * qy + e2z * qz) * inv_det;
+        // Comparisons with NaN are false, so a degenerate lane (det = 0) fails them.
+        let ok: BVec4A = det.cmpne(Vec4::ZERO)
+            & det.abs().cmplt(Vec4::INFINITY)
+            & b1.cmpge(Vec4::ZERO)
+            & b1.cmple(Vec4::ONE)
+            & b2.cmpge(Vec4::ZERO)
+            & (b1 + b2).cmple(Vec4::ONE)
+            & t.cmpge(Vec4::splat(t_min))
+            & t.cmple(Vec4::splat(t_max));
+        (ok.bitmask(), t, b1, b2)
+    }
+}
+
+/// One slab test of `node`'s first `N` lanes for a ray from `o` along `d` over
+/// `[t_min, t_max]`, prepared as the sign of `t_min` requires ([`Prepared`]).
+#[inline(always)]
+pub(super) fn slabs<const N: usize>(
+    o: Vec3A,
+    d: Vec3A,
+    node: &Node,
+    t_min: f32,
+    t_max: f32,
+) -> ([f32; N], u32) {
+    if t_min >= 0.0 {
+        Prepared::<false>::new(o, d).slabs::<N>(node, t_min, t_max)
+    } else {
+        Prepared::<true>::new(o, d).slabs::<N>(node, t_min, t_max)
+    }
+}
+
+/// The lanes set in `mask`, each named by `name(lane)` with its entry distance from `t_near`,
+/// into `out` sorted nearest first (insertion sort: at most eight); returns how many.
+#[inline(always)]
+pub(super) fn by_entry<T: Copy>(
+    mask: u32,
+    t_near: &[f32; ARITY],
+    name: impl Fn(usize) -> T,
+    out: &mut [(T, f32); ARITY],
+) -> usize {
+    let mut n = 0;
+    let mut m = mask;
+    while m != 0 {
+        let lane = m.trailing_zeros() as usize & 7;
+        m &= m - 1;
+        let entry = (name(lane), t_near[lane]);
+        let mut k = n;
+        while k > 0 && out[k - 1].1 > entry.1 {
+            out[k] = out[k - 1];
+            k -= 1;
+        }
+        out[k] = entry;
+        n += 1;
+    }
+    n
+}

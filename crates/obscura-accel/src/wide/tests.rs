@@ -1,0 +1,310 @@
+//! The wide BVH against testing every triangle, and the slab test's rounding bounds.
+
+use super::WideBvh;
+use super::layout::{ARITY, EMPTY, LEAF, Node, WIDTH};
+use super::ray::{FAR_SCALE, slabs};
+use crate::geom::intersect_triangle;
+use glam::{Vec3, Vec3A};
+use obvhs::BvhBuildParams;
+use obvhs::aabb::Aabb;
+
+fn soup(n: usize, seed: u32) -> Vec<[Vec3A; 3]> {
+    // A small deterministic generator: the tests need no statistical quality.
+    let mut state = seed.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
+    let mut next = move || {
+        state = state.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
+        ((state >> 8) as f32 / (1u32 << 24) as f32) * 2.0 - 1.0
+    };
+    (0..n)
+        .map(|_| {
+            let c = Vec3A::new(next(), next(), next()) * 4.0;
+            [0, 1, 2].map(|_| c + Vec3A::new(next(), next(), next()) * 0.3)
+        })
+        .collect()
+}
+
+/// Every input triangle sits in exactly one packet lane (no pre-splits), every node's lane
+/// box contains everything beneath it, and the stack bound covers the real depth.
+#[test]
+fn the_collapse_keeps_every_triangle_once_inside_its_boxes() {
+    for n in [1, 2, 4, 5, 17, 300] {
+        let tris = soup(n, n as u32);
+        let ids = (0..n as u32).map(|i| [i, i + 1000]).collect::<Vec<_>>();
+        let bvh = WideBvh::build(&tris, &ids, BvhBuildParams::medium_build());
+        let mut seen = vec![0u32; n];
+        let mut pending = vec![(bvh.root, None::<[f32; 6]>, 0usize)];
+        let mut depth_max = 0;
+        while let Some((r, bounds, depth)) = pending.pop() {
+            depth_max = depth_max.max(depth);
+            if r & LEAF == 0 {
+                let node = &bvh.nodes[r as usize];
+                for lane in 0..ARITY {
+                    if node.child[lane] == EMPTY {
+                        continue;
+                    }
+                    let b = node.bounds.map(|v| v[lane >> 2][lane & 3]);
+                    if let Some(outer) = bounds {
+                        for axis in 0..3 {
+                            assert!(outer[2 * axis] <= b[2 * axis]);
+                            assert!(outer[2 * axis + 1] >= b[2 * axis + 1]);
+                        }
+                    }
+                    pending.push((node.child[lane], Some(b), depth + 1));
+                }
+            } else {
+                let p = &bvh.packets[(r & !LEAF) as usize];
+                for lane in 0..WIDTH {
+                    if p.ids[0][lane] == EMPTY {
+                        continue;
+                    }
+                    let prim = p.ids[0][lane] as usize;
+                    assert_eq!(p.ids[1][lane], prim as u32 + 1000);
+                    seen[prim] += 1;
+                    // A packet at the root (four triangles or fewer) has no box.
+                    let Some(b) = bounds else { continue };
+                    for corner in tris[prim] {
+                        for axis in 0..3 {
+                            assert!(b[2 * axis] <= corner[axis]);
+                            assert!(corner[axis] <= b[2 * axis + 1]);
+                        }
+                    }
+                }
+            }
+        }
+        assert!(seen.iter().all(|&s| s == 1), "n = {n}: {seen:?}");
+        if n > WIDTH {
+            assert!(bvh.root & LEAF == 0, "more than one packet needs a node");
+        }
+    }
+}
+
+/// Closest and any-hit queries agree with testing every triangle, for rays from every
+/// direction, including axis-aligned ones (zero direction components).
+#[test]
+fn queries_match_testing_every_triangle() {
+    // Small triangles and a few large ones, which the slow preset splits (the same
+    // triangle then sits in several leaves).
+    let mut tris = soup(500, 7);
+    // Long slivers across the box: huge boxes around little area, what splitting is for.
+    for (k, c) in soup(12, 3).iter().enumerate() {
+        let a = c[0].normalize() * 4.0;
+        tris.push([-a, a, a + Vec3A::splat(0.05 * (k + 1) as f32)]);
+    }
+    let ids = (0..tris.len() as u32).map(|i| [i, 7]).collect::<Vec<_>>();
+    for params in [
+        BvhBuildParams::fast_build(),
+        BvhBuildParams::medium_build(),
+        BvhBuildParams::slow_build(),
+    ] {
+        let bvh = WideBvh::build(&tris, &ids, params);
+        let lanes: usize = bvh
+            .packets
+            .iter()
+            .map(|p| p.ids[0].iter().filter(|&&i| i != EMPTY).count())
+            .sum();
+        // Every triangle once, or more than once where the preset splits.
+        assert_eq!(lanes > tris.len(), params.pre_split, "{lanes} lanes");
+        check_against_every_triangle(&tris, &bvh);
+    }
+}
+
+/// A tree large enough for its arrays to move to huge pages answers exactly as testing
+/// every triangle does, and so does its clone.
+#[test]
+fn a_tree_on_huge_pages_answers_the_same() {
+    let tris: Vec<[Vec3A; 3]> = soup(40_000, 11)
+        .into_iter()
+        .map(|[a, b, c]| [a, a + (b - a) * 0.1, a + (c - a) * 0.1])
+        .collect();
+    let ids = (0..tris.len() as u32).map(|i| [i, 7]).collect::<Vec<_>>();
+    let bvh = WideBvh::build(&tris, &ids, BvhBuildParams::fast_build());
+    if cfg!(target_os = "linux") {
+        assert!(
+            bvh.packets.is_mapped(),
+            "{} bytes of packets",
+            bvh.packets.bytes()
+        );
+    }
+    check_against_every_triangle(&tris, &bvh);
+    check_against_every_triangle(&tris, &bvh.clone());
+}
+
+fn check_against_every_triangle(tris: &[[Vec3A; 3]], bvh: &WideBvh) {
+    let dirs = soup(200, 99);
+    for (k, d) in dirs.iter().enumerate() {
+        let o = d[0] * 3.0;
+        let mut dir = d[1] - o;
+        if k % 10 == 0 {
+            dir = Vec3A::new(0.0, 0.0, -o.z);
+        }
+        // Each ray twice: from its origin, and from halfway along it with a range that
+        // starts half a direction behind (the traversal with `t_min < 0`).
+        for (start, t_min) in [(0.0, 0.0), (0.5, -0.5)] {
+            let o = o + dir * start;
+            check_ray(tris, bvh, o, dir, t_min, k);
+        }
+    }
+}
+
+/// One ray's closest and any hit against testing every triangle.
+fn check_ray(tris: &[[Vec3A; 3]], bvh: &WideBvh, o: Vec3A, dir: Vec3A, t_min: f32, k: usize) {
+    let brute = tris
+        .iter()
+        .enumerate()
+        .filter_map(|(i, t)| {
+            intersect_triangle(o, dir, t_min, f32::INFINITY, t).map(|h| (i as u32, h.t))
+        })
+        .min_by(|a, b| a.1.total_cmp(&b.1));
+    let got = bvh.closest(o, dir, t_min, f32::INFINITY);
+    match (brute, got) {
+        (None, None) => {}
+        (Some((_, t_ref)), Some(h)) => {
+            assert!(
+                (t_ref - h.tri.t).abs() <= 1e-4 * t_ref.abs().max(1.0),
+                "ray {k}, t_min {t_min}"
+            );
+            // The record names the triangle hit and carries it as stored.
+            let [v0, v1, v2] = tris[h.ids[0] as usize];
+            assert_eq!(h.ids[1], 7);
+            assert_eq!(Vec3A::from(h.v0), v0);
+            assert_eq!(Vec3A::from(h.e1), v1 - v0);
+            assert_eq!(Vec3A::from(h.e2), v2 - v0);
+            // The point from the barycentrics lies on the triangle's plane to within
+            // a few roundings of its terms; along the plane the barycentrics of a
+            // sliver are ill-conditioned, so it only roughly equals o + t d.
+            let p = h.v0 + h.e1 * h.tri.b1 + h.e2 * h.tri.b2;
+            let n = h.e1.cross(h.e2).normalize();
+            let scale = h.v0.abs() + (h.e1 * h.tri.b1).abs() + (h.e2 * h.tri.b2).abs();
+            let off_plane = n.dot(p - h.v0).abs();
+            assert!(
+                off_plane <= 8.0 * f32::EPSILON * scale.length(),
+                "ray {k}, t_min {t_min}"
+            );
+            let q = Vec3::from(o + dir * h.tri.t);
+            assert!(
+                (p - q).length() <= 1e-3 * q.length().max(1.0),
+                "ray {k}, t_min {t_min}: {p} vs {q}"
+            );
+        }
+        other => panic!("ray {k}, t_min {t_min}: brute force and BVH disagree: {other:?}"),
+    }
+    assert_eq!(
+        bvh.any(o, dir, t_min, f32::INFINITY),
+        brute.is_some(),
+        "ray {k}, t_min {t_min}"
+    );
+}
+
+#[test]
+fn an_empty_tree_hits_nothing() {
+    let bvh = WideBvh::build(&[], &[], BvhBuildParams::fast_build());
+    let (o, d) = (Vec3A::ZERO, Vec3A::X);
+    assert!(bvh.closest(o, d, 0.0, f32::INFINITY).is_none());
+    assert!(!bvh.any(o, d, 0.0, f32::INFINITY));
+}
+
+proptest::proptest! {
+    /// The four-lane slab test (a few-box top level) gives, lane for lane and bit for bit,
+    /// what the eight-lane one (a BVH node) gives its first four lanes, and an unused lane
+    /// is never entered: for boxes of any shape and rays in any direction, axis-parallel
+    /// too, with finite and infinite `t_max`.
+    #[test]
+    fn slab_tests_agree_and_skip_unused_lanes(
+        corners in proptest::collection::vec(proptest::array::uniform6(-8.0f32..8.0), ARITY),
+        empty in proptest::collection::vec(proptest::bool::weighted(0.2), ARITY),
+        o in proptest::array::uniform3(-10.0f32..10.0),
+        d in proptest::array::uniform3(proptest::prop_oneof![
+            -1.0f32..1.0,
+            proptest::strategy::Just(0.0f32),
+            proptest::strategy::Just(-0.0f32),
+        ]),
+        t_min in proptest::prop_oneof![0.0f32..2.0, -2.0f32..0.0],
+        t_max in proptest::prop_oneof![2.0f32..30.0, proptest::strategy::Just(f32::INFINITY)],
+    ) {
+        let mut node = Node::EMPTY;
+        for (lane, c) in corners.iter().enumerate() {
+            if !empty[lane] {
+                let (a, b) = (Vec3::new(c[0], c[1], c[2]), Vec3::new(c[3], c[4], c[5]));
+                let aabb = Aabb::new(a.min(b).into(), a.max(b).into());
+                node.set_box(lane, &aabb);
+            }
+        }
+        let (o, d) = (Vec3A::from_array(o), Vec3A::from_array(d));
+        let (t_near, mask) = slabs::<ARITY>(o, d, &node, t_min, t_max);
+        let (t_near4, mask4) = slabs::<WIDTH>(o, d, &node, t_min, t_max);
+        proptest::prop_assert_eq!(mask4, mask & 0xf);
+        for lane in 0..WIDTH {
+            if mask4 & (1 << lane) != 0 {
+                proptest::prop_assert_eq!(t_near4[lane].to_bits(), t_near[lane].to_bits());
+            }
+        }
+        for (lane, _) in empty.iter().enumerate().filter(|(_, e)| **e) {
+            proptest::prop_assert_eq!(mask & (1 << lane), 0);
+        }
+    }
+
+    /// The slab test never culls a box the ray enters: rays through points on the
+    /// box's twelve edges, ahead of the origin or behind it (reached with `t_min` below
+    /// zero, where far distances get the slack instead of `FAR_SCALE`), are entered
+    /// whenever f64 arithmetic on the same f32 inputs says the ray's range overlaps the
+    /// box by more than f64's own rounding.
+    #[test]
+    fn slab_test_keeps_every_box_the_ray_enters(
+        corner in proptest::array::uniform3(-8.0f32..8.0),
+        size in proptest::array::uniform3(0.01f32..8.0),
+        along in 0.0f32..1.0,
+        d in proptest::array::uniform3(proptest::prop_oneof![-1.0f32..-1e-3, 1e-3f32..1.0]),
+        before in proptest::prop_oneof![0.1f32..20.0, -20.0f32..-0.1],
+        t_min in proptest::prop_oneof![0.0f32..0.05, -30.0f32..0.0],
+        t_max in proptest::prop_oneof![20.0f32..60.0, proptest::strategy::Just(f32::INFINITY)],
+    ) {
+        let lo = Vec3::from_array(corner);
+        let hi = lo + Vec3::from_array(size);
+        let d = Vec3::from_array(d);
+        let mut node = Node::EMPTY;
+        node.set_box(0, &Aabb::new(lo.into(), hi.into()));
+        // Eight points along each edge: one axis runs along it, the other two sit at a
+        // min or a max plane.
+        for edge in 0..12 {
+            for step in 0..8 {
+                let axis = edge % 3;
+                let mut target = [0.0f32; 3];
+                for a in 0..3 {
+                    target[a] = if a == axis {
+                        lo[a] + (hi[a] - lo[a]) * ((step as f32 + along) / 8.0)
+                    } else {
+                        let bit = if a == (axis + 1) % 3 { (edge / 3) & 1 } else { (edge / 6) & 1 };
+                        if bit == 0 { lo[a] } else { hi[a] }
+                    };
+                }
+                let o = Vec3::from_array(target) - d * before;
+                let (_, mask) = slabs::<ARITY>(o.into(), d.into(), &node, t_min, t_max);
+
+                // The same interval in f64 from the same f32 numbers.
+                let (mut near, mut far) = (f64::from(t_min), f64::from(t_max));
+                for a in 0..3 {
+                    let inv = 1.0 / f64::from(d[a]);
+                    let t0 = (f64::from(lo[a]) - f64::from(o[a])) * inv;
+                    let t1 = (f64::from(hi[a]) - f64::from(o[a])) * inv;
+                    near = near.max(t0.min(t1));
+                    far = far.min(t0.max(t1));
+                }
+                if far - near > 1e-12 * far.abs().max(near.abs()).max(1.0) {
+                    proptest::prop_assert_eq!(mask & 1, 1, "near {} far {}", near, far);
+                }
+            }
+        }
+    }
+}
+
+/// [`FAR_SCALE`] outweighs the rounding it must cover, in f64: a far distance computed
+/// in four roundings, scaled, is not below a near distance computed in three.
+#[test]
+fn far_scale_covers_the_rounding() {
+    let u = f64::from(f32::EPSILON) * 0.5;
+    let gamma = |n: f64| n * u / (1.0 - n * u);
+    assert!(f64::from(FAR_SCALE) * (1.0 - gamma(4.0)) >= 1.0 + gamma(3.0));
+    // And it is no bigger than it must be: one ulp less would not do.
+    let smaller = f64::from(f32::from_bits(FAR_SCALE.to_bits() - 1));
+    assert!(smaller * (1.0 - gamma(4.0)) < 1.0 + gamma(3.0));
+}

@@ -1,0 +1,337 @@
+//! The area light: any emissive shape of obscura-accel, at its instance's placement.
+
+use super::solid_angle::{
+    area_to_solid_angle, cone_pdf, normal_matrix, orientation_sign, world_sphere,
+};
+use super::{LightSample, TINY};
+use crate::distribution::Distribution1D;
+use crate::error::{ShadeError, check_non_negative};
+use core::f32::consts::{PI, TAU};
+use glam::{Mat3, Vec2, Vec3};
+use obscura_accel::{Placement, Shape, TriangleMesh};
+use obscura_sample::square_to_uniform_sphere;
+use obscura_space::{Object, Transform, World};
+
+/// An emissive shape: emits `emission` (radiance) on the side its geometric normal faces.
+///
+/// Sampling: spheres by the solid angle of the cone they subtend (when their placement is a
+/// similarity; an ellipsoid falls back to area sampling with the exact area Jacobian), quads
+/// by area, meshes by choosing a triangle by object-space area, then a uniform point on it in
+/// world space. Pdfs are converted to solid angle. A moving emitter is evaluated at the
+/// reference point's time.
+#[derive(Debug, Clone)]
+pub struct AreaLight {
+    instance: u32,
+    emission: Vec3,
+    shape: Shape,
+    /// For a mesh: its triangles chosen in proportion to their object-space areas.
+    by_area: Option<Distribution1D>,
+    /// Boxed: transforms are large, and [`Light`](super::Light)'s variants should stay close
+    /// in size.
+    placement: Box<Placement>,
+}
+
+/// A point sampled on an emitter's surface, with its unit outward normal and area density.
+struct SurfacePoint {
+    p: Vec3,
+    n: Vec3,
+    pdf_area: f32,
+}
+
+impl AreaLight {
+    /// An area light for instance `instance` of the geometry, with the accelerator's shape and
+    /// placement. Errors on a non-finite or negative emission.
+    pub fn new(
+        shape: &Shape,
+        placement: &Placement,
+        emission: Vec3,
+        instance: u32,
+    ) -> Result<AreaLight, ShadeError> {
+        check_non_negative(emission, "emission")?;
+        let by_area = match shape {
+            Shape::Sphere { center, radius } => {
+                if !center.is_finite() || !radius.is_finite() {
+                    return Err(ShadeError::NotFinite {
+                        parameter: "emissive sphere",
+                    });
+                }
+                if *radius <= 0.0 {
+                    return Err(ShadeError::OutOfRange {
+                        parameter: "emissive sphere radius",
+                        expected: "greater than 0",
+                    });
+                }
+                None
+            }
+            Shape::Quad {
+                origin,
+                edge_u,
+                edge_v,
+            } => {
+                if !(origin.is_finite() && edge_u.is_finite() && edge_v.is_finite()) {
+                    return Err(ShadeError::NotFinite {
+                        parameter: "emissive quad",
+                    });
+                }
+                if edge_u.cross(*edge_v).length_squared() <= 0.0 {
+                    return Err(ShadeError::OutOfRange {
+                        parameter: "emissive quad edges",
+                        expected: "non-parallel and non-zero (the quad needs an area)",
+                    });
+                }
+                None
+            }
+            Shape::Mesh(mesh) => {
+                // A `TriangleMesh` holds only indices in range (checked when it was made).
+                let areas: Vec<f32> = (0..mesh.triangle_count())
+                    .filter_map(|i| corners(mesh, i))
+                    .map(|[a, b, c]| 0.5 * (b - a).cross(c - a).length())
+                    .collect();
+                Some(Distribution1D::new(&areas))
+            }
+        };
+        Ok(AreaLight {
+            instance,
+            emission,
+            shape: shape.clone(),
+            by_area,
+            placement: Box::new(placement.clone()),
+        })
+    }
+
+    /// The geometry instance this light belongs to.
+    pub fn instance(&self) -> u32 {
+        self.instance
+    }
+
+    /// The emitted radiance.
+    pub fn emission(&self) -> Vec3 {
+        self.emission
+    }
+
+    /// Radiance leaving a point with geometric normal `n_geometric` towards `w` (world, unit):
+    /// the emission on the front side, zero behind.
+    pub fn emitted(&self, n_geometric: Vec3, w: Vec3) -> Vec3 {
+        if n_geometric.dot(w) > 0.0 {
+            self.emission
+        } else {
+            Vec3::ZERO
+        }
+    }
+
+    /// Samples a direction from `p_ref` towards this light at `time`.
+    pub fn sample_li(&self, p_ref: Vec3, time: f32, u2: Vec2) -> Option<LightSample> {
+        let world_from_object = self.placement.at(time);
+        // Spheres that stay spheres: sample the cone they subtend.
+        if let Shape::Sphere { center, radius } = self.shape
+            && let Some((c_world, r_world)) = world_sphere(&world_from_object, center, radius)
+        {
+            return self.sample_cone(p_ref, c_world, r_world, u2);
+        }
+        // Everything else: a point by area, converted to solid angle.
+        let s = self.sample_area(&world_from_object, u2)?;
+        let to_light = s.p - p_ref;
+        let d2 = to_light.length_squared();
+        if d2 <= TINY {
+            return None;
+        }
+        let wi = to_light / d2.sqrt();
+        let cos_light = s.n.dot(-wi);
+        if cos_light <= TINY {
+            return None;
+        }
+        let pdf = s.pdf_area * d2 / cos_light;
+        if !pdf.is_finite() || pdf <= 0.0 {
+            return None;
+        }
+        Some(LightSample {
+            wi,
+            radiance: self.emission,
+            pdf,
+            p_light: Some(s.p),
+            delta: false,
+        })
+    }
+
+    /// The solid-angle density with which [`AreaLight::sample_li`] from `p_ref` picks the point
+    /// `p_light` (on this light, geometric normal `n_light`, on triangle `primitive` for meshes)
+    /// at `time`.
+    pub fn pdf_li(
+        &self,
+        p_ref: Vec3,
+        p_light: Vec3,
+        n_light: Vec3,
+        primitive: u32,
+        time: f32,
+    ) -> f32 {
+        let world_from_object = self.placement.at(time);
+        if let Shape::Sphere { center, radius } = self.shape
+            && let Some((c_world, r_world)) = world_sphere(&world_from_object, center, radius)
+        {
+            let d2 = (c_world - p_ref).length_squared();
+            let r2 = r_world * r_world;
+            if d2 > r2 {
+                return cone_pdf(r2 / d2);
+            }
+            // Inside the sphere: sampled by area (and nothing is emitted inwards).
+            return area_to_solid_angle(1.0 / (4.0 * PI * r2), p_ref, p_light, n_light);
+        }
+        let pdf_area = self.pdf_area(&world_from_object, p_light, primitive);
+        area_to_solid_angle(pdf_area, p_ref, p_light, n_light)
+    }
+
+    /// Cone sampling of a world-space sphere (pbrt's method), from outside it.
+    fn sample_cone(&self, p_ref: Vec3, c: Vec3, r: f32, u2: Vec2) -> Option<LightSample> {
+        let to_center = c - p_ref;
+        let dc2 = to_center.length_squared();
+        let r2 = r * r;
+        if dc2 <= r2 * (1.0 + 1e-5) {
+            // Inside (or on) an outward-emitting sphere: it sends nothing here.
+            return None;
+        }
+        let dc = dc2.sqrt();
+        let w_c = to_center / dc;
+        // Sample cos(theta) uniformly in [cos_max, 1]; small cones via sin^2 to keep precision.
+        let sin2_max = r2 / dc2;
+        let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
+        let one_minus_cos_max = sin2_max / (1.0 + cos_max);
+        let sin2_theta = u2.x * one_minus_cos_max * (2.0 - u2.x * one_minus_cos_max);
+        let cos_theta = (1.0 - sin2_theta).max(0.0).sqrt();
+        // The point on the sphere seen at that angle: the nearer intersection of the ray.
+        let ds = dc * cos_theta - (r2 - dc2 * sin2_theta).max(0.0).sqrt();
+        let cos_alpha = ((dc2 + r2 - ds * ds) / (2.0 * dc * r)).clamp(-1.0, 1.0);
+        let sin_alpha = (1.0 - cos_alpha * cos_alpha).max(0.0).sqrt();
+        let phi = TAU * u2.y;
+        let frame = crate::frame::Frame::from_normal(-w_c);
+        let n_light = frame.from_local(Vec3::new(
+            sin_alpha * phi.cos(),
+            sin_alpha * phi.sin(),
+            cos_alpha,
+        ));
+        let p_light = c + r * n_light;
+        let wi = (p_light - p_ref).try_normalize()?;
+        let pdf = cone_pdf(sin2_max);
+        if !pdf.is_finite() {
+            return None;
+        }
+        Some(LightSample {
+            wi,
+            radiance: self.emission,
+            pdf,
+            p_light: Some(p_light),
+            delta: false,
+        })
+    }
+
+    /// A point uniform by world area on shapes other than cone-sampled spheres.
+    fn sample_area(
+        &self,
+        world_from_object: &Transform<World, Object>,
+        u2: Vec2,
+    ) -> Option<SurfacePoint> {
+        let m = world_from_object.matrix();
+        let normal_matrix = normal_matrix(world_from_object);
+        let orientation = orientation_sign(&m);
+        match &self.shape {
+            Shape::Sphere { center, radius } => {
+                // An ellipsoid: uniform on the object sphere, divided by the area Jacobian.
+                let n_object = square_to_uniform_sphere(u2);
+                let p = m.transform_point3(*center + *radius * n_object);
+                let n_mapped = normal_matrix * n_object;
+                let jacobian = Mat3::from_mat4(m).determinant().abs() * n_mapped.length();
+                let pdf_area = 1.0 / (4.0 * PI * radius * radius * jacobian);
+                Some(SurfacePoint {
+                    p,
+                    n: n_mapped.try_normalize()?,
+                    pdf_area,
+                })
+            }
+            Shape::Quad {
+                origin,
+                edge_u,
+                edge_v,
+            } => {
+                let o = m.transform_point3(*origin);
+                let eu = m.transform_vector3(*edge_u);
+                let ev = m.transform_vector3(*edge_v);
+                let cross = eu.cross(ev);
+                let area = cross.length();
+                if area <= TINY {
+                    return None;
+                }
+                Some(SurfacePoint {
+                    p: o + u2.x * eu + u2.y * ev,
+                    n: orientation * cross / area,
+                    pdf_area: 1.0 / area,
+                })
+            }
+            Shape::Mesh(mesh) => {
+                let by_area = self.by_area.as_ref()?;
+                let (i, p_triangle, u_remapped) = by_area.sample_discrete(u2.x);
+                let [a, b, c] = corners(mesh, i)?.map(|v| m.transform_point3(v));
+                let cross = (b - a).cross(c - a);
+                let area = 0.5 * cross.length();
+                if area <= TINY {
+                    return None;
+                }
+                // Uniform barycentrics by the square-root warp.
+                let su = u_remapped.sqrt();
+                let (b0, b1) = (1.0 - su, u2.y * su);
+                Some(SurfacePoint {
+                    p: b0 * a + b1 * b + (1.0 - b0 - b1) * c,
+                    n: orientation * cross / (2.0 * area),
+                    pdf_area: p_triangle / area,
+                })
+            }
+        }
+    }
+
+    /// The area density of [`AreaLight::sample_area`] at a world point on this light.
+    fn pdf_area(
+        &self,
+        world_from_object: &Transform<World, Object>,
+        p_light: Vec3,
+        primitive: u32,
+    ) -> f32 {
+        let m = world_from_object.matrix();
+        match &self.shape {
+            Shape::Sphere { center, radius } => {
+                let p_object = world_from_object.inverse_matrix().transform_point3(p_light);
+                let Some(n_object) = (p_object - *center).try_normalize() else {
+                    return 0.0;
+                };
+                let n_mapped = normal_matrix(world_from_object) * n_object;
+                let jacobian = Mat3::from_mat4(m).determinant().abs() * n_mapped.length();
+                1.0 / (4.0 * PI * radius * radius * jacobian)
+            }
+            Shape::Quad { edge_u, edge_v, .. } => {
+                let area = m
+                    .transform_vector3(*edge_u)
+                    .cross(m.transform_vector3(*edge_v))
+                    .length();
+                if area <= TINY { 0.0 } else { 1.0 / area }
+            }
+            Shape::Mesh(mesh) => {
+                let (Some(by_area), Some(tri)) = (&self.by_area, corners(mesh, primitive as usize))
+                else {
+                    return 0.0;
+                };
+                let [a, b, c] = tri.map(|v| m.transform_point3(v));
+                let area = 0.5 * (b - a).cross(c - a).length();
+                if area <= TINY {
+                    0.0
+                } else {
+                    by_area.discrete_pdf(primitive as usize) / area
+                }
+            }
+        }
+    }
+}
+
+/// The object-space corners of triangle `i` of `mesh`; `None` past the last triangle.
+fn corners(mesh: &TriangleMesh, i: usize) -> Option<[Vec3; 3]> {
+    let positions = mesh.positions();
+    mesh.triangles()
+        .get(i)
+        .map(|tri| tri.map(|v| positions[v as usize]))
+}

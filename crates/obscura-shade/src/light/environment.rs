@@ -1,0 +1,193 @@
+//! The environment light: constant radiance, or an equirectangular map importance-sampled by
+//! luminance.
+
+use super::{LightSample, TINY, luminance};
+use crate::distribution::Distribution2D;
+use crate::error::{ShadeError, check_non_negative};
+use core::f32::consts::{PI, TAU};
+use glam::{Mat3, Mat4, Vec2, Vec3};
+use obscura_sample::{square_to_uniform_sphere, uniform_sphere_pdf};
+
+/// Light from every direction at infinity: a constant radiance or an equirectangular map.
+#[derive(Debug, Clone)]
+pub struct EnvironmentLight {
+    kind: EnvironmentKind,
+}
+
+/// What an [`EnvironmentLight`] holds.
+#[derive(Debug, Clone)]
+enum EnvironmentKind {
+    Constant(Vec3),
+    Map(Box<LatLongMap>),
+}
+
+/// An equirectangular (latitude-longitude) radiance map with its sampling distribution.
+#[derive(Debug, Clone)]
+struct LatLongMap {
+    width: u32,
+    height: u32,
+    texels: Vec<Vec3>,
+    distribution: Distribution2D,
+    world_from_light: Mat3,
+    light_from_world: Mat3,
+}
+
+impl EnvironmentLight {
+    /// A uniform environment of the given radiance.
+    pub fn constant(radiance: Vec3) -> Result<EnvironmentLight, ShadeError> {
+        check_non_negative(radiance, "radiance")?;
+        Ok(EnvironmentLight {
+            kind: EnvironmentKind::Constant(radiance),
+        })
+    }
+
+    /// An equirectangular map of `width x height` linear-RGB texels, row 0 at the top
+    /// (`+y` of the light's frame), with the light's frame placed in the world by the rotation
+    /// `world_from_light` (its translation is ignored; its linear part must be orthonormal).
+    pub fn from_texels(
+        width: u32,
+        height: u32,
+        texels: Vec<Vec3>,
+        world_from_light: Mat4,
+    ) -> Result<EnvironmentLight, ShadeError> {
+        if width == 0 || height == 0 {
+            return Err(ShadeError::OutOfRange {
+                parameter: "environment map size",
+                expected: "at least 1 x 1",
+            });
+        }
+        let expected = u64::from(width) * u64::from(height);
+        if texels.len() as u64 != expected {
+            return Err(ShadeError::TexelCount {
+                expected,
+                actual: texels.len(),
+            });
+        }
+        for t in &texels {
+            check_non_negative(*t, "environment map texel")?;
+        }
+        if !world_from_light.is_finite() {
+            return Err(ShadeError::NotFinite {
+                parameter: "environment transform",
+            });
+        }
+        let rotation = Mat3::from_mat4(world_from_light);
+        let gram = rotation.transpose() * rotation;
+        if !gram.abs_diff_eq(Mat3::IDENTITY, 1e-3) {
+            return Err(ShadeError::OutOfRange {
+                parameter: "environment transform",
+                expected: "a rotation (orthonormal linear part)",
+            });
+        }
+        // Weights: luminance times sin(theta) at the row's centre (rows near the poles cover
+        // less solid angle).
+        let (w, h) = (width as usize, height as usize);
+        let mut weights = Vec::with_capacity(w * h);
+        for y in 0..h {
+            let sin_theta = (PI * (y as f32 + 0.5) / h as f32).sin();
+            for x in 0..w {
+                weights.push(luminance(texels[y * w + x]) * sin_theta);
+            }
+        }
+        let distribution = Distribution2D::new(&weights, w, h);
+        Ok(EnvironmentLight {
+            kind: EnvironmentKind::Map(Box::new(LatLongMap {
+                width,
+                height,
+                texels,
+                distribution,
+                world_from_light: rotation,
+                light_from_world: rotation.transpose(),
+            })),
+        })
+    }
+
+    /// The radiance arriving from world direction `d_world` (unit), i.e. seen looking along it.
+    pub fn radiance(&self, d_world: Vec3) -> Vec3 {
+        match &self.kind {
+            EnvironmentKind::Constant(l) => *l,
+            EnvironmentKind::Map(map) => {
+                let uv = direction_to_uv(map.light_from_world * d_world);
+                map.texel(uv)
+            }
+        }
+    }
+
+    /// Samples a direction (by luminance for maps, uniformly for a constant).
+    pub fn sample_li(&self, u2: Vec2) -> Option<LightSample> {
+        match &self.kind {
+            EnvironmentKind::Constant(l) => Some(LightSample {
+                wi: square_to_uniform_sphere(u2),
+                radiance: *l,
+                pdf: uniform_sphere_pdf(),
+                p_light: None,
+                delta: false,
+            }),
+            EnvironmentKind::Map(map) => {
+                let (uv, pdf_uv) = map.distribution.sample(u2);
+                let sin_theta = (PI * uv.y).sin();
+                if pdf_uv <= 0.0 || sin_theta <= TINY {
+                    return None;
+                }
+                let d_light = uv_to_direction(uv);
+                Some(LightSample {
+                    wi: (map.world_from_light * d_light).normalize(),
+                    radiance: map.texel(uv),
+                    pdf: pdf_uv / (2.0 * PI * PI * sin_theta),
+                    p_light: None,
+                    delta: false,
+                })
+            }
+        }
+    }
+
+    /// The solid-angle density with which [`EnvironmentLight::sample_li`] returns `d_world`.
+    pub fn pdf_li(&self, d_world: Vec3) -> f32 {
+        match &self.kind {
+            EnvironmentKind::Constant(_) => uniform_sphere_pdf(),
+            EnvironmentKind::Map(map) => {
+                let d_light = map.light_from_world * d_world;
+                let uv = direction_to_uv(d_light);
+                // sin(theta) from the direction itself: well conditioned at the poles, where
+                // going through acos would lose most digits.
+                let sin_theta = Vec2::new(d_light.x, d_light.z).length() / d_light.length();
+                if sin_theta <= TINY {
+                    return 0.0;
+                }
+                map.distribution.pdf(uv) / (2.0 * PI * PI * sin_theta)
+            }
+        }
+    }
+}
+
+impl LatLongMap {
+    /// The texel holding map coordinates `uv` in `[0, 1]^2` (nearest, no filtering: the
+    /// radiance is piecewise constant exactly like the sampling density).
+    fn texel(&self, uv: Vec2) -> Vec3 {
+        let x = ((uv.x * self.width as f32) as u32).min(self.width - 1);
+        let y = ((uv.y * self.height as f32) as u32).min(self.height - 1);
+        self.texels[(y * self.width + x) as usize]
+    }
+}
+
+/// Map coordinates of a unit direction in the light's frame: `u = phi / 2pi + 1/2` with
+/// `phi = atan2(x, z)` from +z towards +x, `v = theta / pi` with `theta` from +y (the
+/// environment camera's mapping).
+pub fn direction_to_uv(d_light: Vec3) -> Vec2 {
+    // atan2 rather than acos(y): accurate near the poles too.
+    let theta = Vec2::new(d_light.x, d_light.z).length().atan2(d_light.y);
+    let phi = d_light.x.atan2(d_light.z);
+    let u = (phi / TAU + 0.5).clamp(0.0, 1.0);
+    let v = (theta / PI).clamp(0.0, 1.0);
+    Vec2::new(u, v)
+}
+
+/// The inverse of [`direction_to_uv`]: `d = (sin theta sin phi, cos theta, sin theta cos phi)`
+/// with `theta = pi v`, `phi = 2 pi (u - 1/2)`.
+pub fn uv_to_direction(uv: Vec2) -> Vec3 {
+    let theta = PI * uv.y;
+    let phi = TAU * (uv.x - 0.5);
+    let (sin_theta, cos_theta) = theta.sin_cos();
+    let (sin_phi, cos_phi) = phi.sin_cos();
+    Vec3::new(sin_theta * sin_phi, cos_theta, sin_theta * cos_phi)
+}
