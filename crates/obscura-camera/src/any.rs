@@ -3,6 +3,8 @@
 use crate::camera::{Camera, CameraRay, CameraRayDifferential, CameraSample};
 use crate::environment::EnvironmentCamera;
 use crate::film::{FilmGeometry, Shutter};
+use crate::opencv::OpenCvCamera;
+use crate::opencv_fisheye::OpenCvFisheyeCamera;
 use crate::orthographic::OrthographicCamera;
 use crate::perspective::PerspectiveCamera;
 use obscura_space::{AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, World};
@@ -16,6 +18,10 @@ pub enum AnyCamera {
     Orthographic(OrthographicCamera),
     /// An environment camera.
     Environment(EnvironmentCamera),
+    /// An OpenCV pinhole camera with distortion.
+    OpenCv(OpenCvCamera),
+    /// An OpenCV (Kannala-Brandt) fisheye camera.
+    OpenCvFisheye(OpenCvFisheyeCamera),
 }
 
 macro_rules! dispatch {
@@ -24,6 +30,8 @@ macro_rules! dispatch {
             AnyCamera::Perspective($c) => $e,
             AnyCamera::Orthographic($c) => $e,
             AnyCamera::Environment($c) => $e,
+            AnyCamera::OpenCv($c) => $e,
+            AnyCamera::OpenCvFisheye($c) => $e,
         }
     };
 }
@@ -76,5 +84,15 @@ impl From<OrthographicCamera> for AnyCamera {
 impl From<EnvironmentCamera> for AnyCamera {
     fn from(c: EnvironmentCamera) -> Self {
         AnyCamera::Environment(c)
+    }
+}
+impl From<OpenCvCamera> for AnyCamera {
+    fn from(c: OpenCvCamera) -> Self {
+        AnyCamera::OpenCv(c)
+    }
+}
+impl From<OpenCvFisheyeCamera> for AnyCamera {
+    fn from(c: OpenCvFisheyeCamera) -> Self {
+        AnyCamera::OpenCvFisheye(c)
     }
 }

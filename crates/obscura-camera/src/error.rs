@@ -80,6 +80,20 @@ pub enum CameraError {
     },
     /// The camera pose could not be built (a degenerate look-at, mirrored keyframes...).
     Pose(SpaceError),
+    /// A focal length (`fx` or `fy`, in pixels) that is not positive.
+    FocalLength {
+        /// The parameter's name, `"fx"` or `"fy"`.
+        what: &'static str,
+        /// The value given.
+        got: f64,
+    },
+    /// A distortion list of a length the model does not read.
+    DistortionLength {
+        /// The camera type, `"opencv"` or `"opencv_fisheye"`.
+        model: &'static str,
+        /// The number of entries given.
+        got: usize,
+    },
 }
 
 impl fmt::Display for CameraError {
@@ -149,6 +163,20 @@ impl fmt::Display for CameraError {
                 "shutter must be finite with open <= close, got [{open}, {close}]"
             ),
             CameraError::Pose(e) => write!(f, "camera pose: {e}"),
+            CameraError::FocalLength { what, got } => {
+                write!(f, "{what} must be > 0 pixels, got {got}")
+            }
+            CameraError::DistortionLength { model, got } => {
+                let lengths = if *model == "opencv" {
+                    "4, 5, 8 or 12"
+                } else {
+                    "4"
+                };
+                write!(
+                    f,
+                    "distortion of an {model} camera must have {lengths} entries, got {got}"
+                )
+            }
         }
     }
 }

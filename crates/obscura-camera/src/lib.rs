@@ -62,6 +62,8 @@ mod camera;
 mod environment;
 mod error;
 mod film;
+mod opencv;
+mod opencv_fisheye;
 mod orthographic;
 mod perspective;
 mod projective;
@@ -74,6 +76,10 @@ pub use camera::{
 pub use environment::EnvironmentCamera;
 pub use error::CameraError;
 pub use film::{FilmGeometry, FovAxis, MAX_RESOLUTION, ScreenWindow, Shutter};
+pub use opencv::{
+    OPENCV_INVERSE_TOLERANCE_PX, OPENCV_MAX_RADIUS, OpenCvCamera, OpenCvIntrinsics, opencv_pose,
+};
+pub use opencv_fisheye::{FISHEYE_INVERSE_TOLERANCE_PX, OpenCvFisheyeCamera};
 pub use orthographic::OrthographicCamera;
 pub use perspective::PerspectiveCamera;
 pub use projective::ProjectiveCamera;
