@@ -64,10 +64,7 @@ impl OpenCvIntrinsics {
     /// y + cy`, plus 0.5 for Obscura's pixel centres.
     #[inline]
     pub fn raster(&self, q: DVec2) -> DVec2 {
-        DVec2::new(
-            self.fx * q.x + self.cx + 0.5,
-            self.fy * q.y + self.cy + 0.5,
-        )
+        DVec2::new(self.fx * q.x + self.cx + 0.5, self.fy * q.y + self.cy + 0.5)
     }
 }
 
@@ -160,10 +157,9 @@ pub fn opencv_pose(
             got: f32::INFINITY,
         });
     }
-    Ok(AnimatedTransform::fixed(Transform::from_matrix_and_inverse(
-        m.as_mat4(),
-        m_inv.as_mat4(),
-    )))
+    Ok(AnimatedTransform::fixed(
+        Transform::from_matrix_and_inverse(m.as_mat4(), m_inv.as_mat4()),
+    ))
 }
 
 /// Converts between Obscura's camera frame (+y up) and OpenCV's (+y down): flips y.
@@ -211,7 +207,11 @@ pub(crate) fn world_ray(
     t_max: f32,
     time: f32,
 ) -> Ray<World> {
-    let ray = pose.ray(Ray::new(Point3::ORIGIN, Vector3::from_glam(d.as_vec3()), time));
+    let ray = pose.ray(Ray::new(
+        Point3::ORIGIN,
+        Vector3::from_glam(d.as_vec3()),
+        time,
+    ));
     let length = ray.direction.length();
     let direction = ray.direction / length;
     let (t_min, t_max) = if (length - 1.0).abs() <= 1e-5 {
@@ -312,36 +312,55 @@ impl Distortion {
         d > 0.0 && c + 2.0 * r2 * dc > 0.0
     }
 
-    /// The first radius where [`Distortion::radial_ok`] fails, searched on a geometric grid up
-    /// to [`OPENCV_MAX_RADIUS`] and refined by bisection; [`OPENCV_MAX_RADIUS`] when it never
-    /// fails there.
+    /// The valid radius: the first radius where [`Distortion::radial_ok`] fails (the radial
+    /// fold), or, when there are tangential or prism terms, the smaller first radius along any
+    /// of 360 directions where the Jacobian determinant of the full 2D map stops being
+    /// positive; [`OPENCV_MAX_RADIUS`] when nothing folds before it.
     fn fold_radius(&self) -> f64 {
-        const STEPS: usize = 8192;
-        const R_MIN: f64 = 1e-3;
-        // g'(0) = c(0) = 1 > 0; scan r = R_MIN * (R_MAX / R_MIN)^(i / STEPS).
-        let ratio = (OPENCV_MAX_RADIUS / R_MIN).powf(1.0 / STEPS as f64);
-        let mut lo = 0.0;
-        let mut r = R_MIN;
-        for _ in 0..=STEPS {
-            if !self.radial_ok(r) {
-                let mut hi = r;
-                for _ in 0..200 {
-                    let mid = 0.5 * (lo + hi);
-                    if mid <= lo || mid >= hi {
-                        break;
-                    }
-                    if self.radial_ok(mid) {
-                        lo = mid;
-                    } else {
-                        hi = mid;
-                    }
-                }
-                return lo;
-            }
-            lo = r;
-            r = (r * ratio).min(OPENCV_MAX_RADIUS);
+        let radial = first_failure(|r| self.radial_ok(r), OPENCV_MAX_RADIUS, 8192);
+        if self.p == [0.0; 2] && self.s == [0.0; 4] {
+            // Radial only: det = c g' with c = g / r > 0 inside, so the radial fold is all.
+            return radial;
         }
-        OPENCV_MAX_RADIUS
+        const ANGLES: usize = 360;
+        let mut r_max = radial;
+        for i in 0..ANGLES {
+            let (sin, cos) = (core::f64::consts::TAU * i as f64 / ANGLES as f64).sin_cos();
+            let direction = DVec2::new(cos, sin);
+            let ok = |r: f64| self.apply(direction * r).1.determinant() > 0.0;
+            r_max = r_max.min(first_failure(ok, r_max, 256));
+        }
+        r_max
+    }
+
+    /// The radius `r` in `[0, r_max)` with `g(r) = r c(r^2) = rho` (`g` increases there), by
+    /// Newton's method kept inside a shrinking bracket (bisection when a step leaves it); a
+    /// radius just inside `r_max` when `rho` is at or past `g(r_max)`.
+    fn radial_inverse(&self, rho: f64, r_max: f64) -> f64 {
+        let (mut lo, mut hi) = (0.0, r_max);
+        let mut r = rho.min(0.5 * r_max);
+        for _ in 0..100 {
+            let r2 = r * r;
+            let (c, dc, _) = self.radial(r2);
+            let residual = r * c - rho;
+            if residual == 0.0 {
+                return r;
+            }
+            if residual > 0.0 {
+                hi = r;
+            } else {
+                lo = r;
+            }
+            let mut next = r - residual / (c + 2.0 * r2 * dc);
+            if !(next > lo && next < hi) {
+                next = 0.5 * (lo + hi);
+            }
+            if next == r {
+                break;
+            }
+            r = next;
+        }
+        r.min(0.999 * r_max)
     }
 
     /// The distorted normalised point of an undistorted one, and the Jacobian of the map
@@ -369,6 +388,39 @@ impl Distortion {
     }
 }
 
+/// The first `r` in `(0, r_hi]` where `ok` fails, scanned on a geometric grid of `steps`
+/// steps from 1e-3 (`ok` holds at 0 for every caller) and refined by bisection to f64
+/// precision; `r_hi` when it never fails on the grid.
+fn first_failure(ok: impl Fn(f64) -> bool, r_hi: f64, steps: usize) -> f64 {
+    const R_MIN: f64 = 1e-3;
+    let ratio = (r_hi / R_MIN).max(1.0).powf(1.0 / steps as f64);
+    let mut lo = 0.0;
+    let mut r = R_MIN.min(r_hi);
+    for _ in 0..=steps {
+        if !ok(r) {
+            let mut hi = r;
+            for _ in 0..200 {
+                let mid = 0.5 * (lo + hi);
+                if mid <= lo || mid >= hi {
+                    break;
+                }
+                if ok(mid) {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            return lo;
+        }
+        lo = r;
+        if r >= r_hi {
+            break;
+        }
+        r = (r * ratio).min(r_hi);
+    }
+    r_hi
+}
+
 /// The OpenCV pinhole camera with distortion, exactly as `cv::projectPoints` (OpenCV's
 /// documentation of the calib3d module, "Detailed Description"). A point of OpenCV's camera
 /// frame `(X, Y, Z)` (x right, y down, z forward; `Z > 0`) maps to
@@ -391,16 +443,20 @@ impl Distortion {
 /// image's top is the look-at's up, its right the look-at's right, as for every camera.
 ///
 /// Valid region: the radial map `g(r) = r c(r^2)` folds over where `g'(r) = c + 2 r^2 dc/dr^2`
-/// first stops being positive (or the denominator reaches 0). That radius `r_max` is found once
-/// at construction (a geometric scan up to [`OPENCV_MAX_RADIUS`], then bisection). A point with
-/// `r >= r_max` is not projected, and no ray leaves towards it. The tangential and thin-prism
-/// terms are not part of that radius; they can fold the 2D map slightly inside it, so the
-/// valid region is also restricted to where the Jacobian determinant of `(x', y') -> (x'',
-/// y'')` is positive, both in `project` and for the ray found by the inverse.
+/// first stops being positive (or the denominator reaches 0). The tangential and thin-prism
+/// terms can fold the 2D map `(x', y') -> (x'', y'')` before that, in some directions only: so
+/// the valid radius `r_max` is the smaller of the radial fold and the first radius, along any
+/// of 360 directions, where the 2D map's Jacobian determinant stops being positive (for a
+/// purely radial model the two agree: the determinant is `c g'`). `r_max` is found once at
+/// construction (a geometric scan up to [`OPENCV_MAX_RADIUS`], then bisection) and
+/// [`OpenCvCamera::valid_radius`] reports it. A point with `r >= r_max`, or where the
+/// determinant is not positive (a fold thinner than the angular scan), is not projected, and no
+/// ray leaves towards it.
 ///
-/// Inverse: Newton's method in 2D on `(x', y')` with the closed-form Jacobian, from
-/// `(x'', y'')` (pulled inside `r_max`), each step halved until it stays inside `r_max` and
-/// lowers the residual. A ray is given only when its point re-projects within
+/// Inverse: Newton's method in 2D on `(x', y')` with the closed-form Jacobian, started from
+/// the radial-only inverse along the direction of `(x'', y'')` (a 1D safeguarded Newton on
+/// `g`), each step halved until it stays inside `r_max` with a positive determinant and lowers
+/// the residual. A ray is given only when its point re-projects within
 /// [`OPENCV_INVERSE_TOLERANCE_PX`] (well inside the stated 1e-4 px) in f64; otherwise (past
 /// the fold, where no point maps) there is none. Rays run from the eye along the unit
 /// direction `normalize(x', -y', 1)`, clipped to camera z in `[near, far]` as a perspective
@@ -486,14 +542,27 @@ impl OpenCvCamera {
         }
         let d = &self.distortion;
         let scale = DVec2::new(self.intrinsics.fx, self.intrinsics.fy);
-        // Residual in pixels: the tolerance is stated in pixels.
-        let error = |f: DVec2| ((f - target) * scale).abs().max_element();
-        let mut q = target;
-        let limit = 0.999 * self.r_max;
-        if q.length() >= limit {
-            q *= limit / q.length();
-        }
+        // Residual in pixels (the tolerance is stated in pixels); Euclidean for the descent.
+        let error = |f: DVec2| ((f - target) * scale).length();
+        // Start from the radial-only inverse along the target's direction: the tangential and
+        // prism terms are small corrections to it.
+        let rho = target.length();
+        let mut q = if rho > 0.0 {
+            target * (d.radial_inverse(rho, self.r_max) / rho)
+        } else {
+            target
+        };
         let (mut f, mut jacobian) = d.apply(q);
+        // Where the tangential and prism terms fold the map inside r_max, pull the start in
+        // towards the centre until it is on the unfolded side (det > 0), and keep every step
+        // there: the solution is the preimage in the region `distort` accepts.
+        for _ in 0..200 {
+            if jacobian.determinant() > 0.0 {
+                break;
+            }
+            q *= 0.95;
+            (f, jacobian) = d.apply(q);
+        }
         let mut err = error(f);
         for _ in 0..100 {
             if err <= 1e-3 * OPENCV_INVERSE_TOLERANCE_PX {
@@ -504,7 +573,8 @@ impl OpenCvCamera {
                 return None;
             }
             let step = jacobian.inverse() * (f - target);
-            // Halve the step until it stays inside r_max and lowers the residual.
+            // Halve the step until it stays inside r_max, on the unfolded side, and lowers the
+            // residual.
             let mut lambda = 1.0;
             let mut moved = false;
             while lambda > 1e-12 {
@@ -512,7 +582,7 @@ impl OpenCvCamera {
                 if next.length() < self.r_max {
                     let (f_next, j_next) = d.apply(next);
                     let err_next = error(f_next);
-                    if err_next < err {
+                    if err_next < err && j_next.determinant() > 0.0 {
                         (q, f, jacobian, err) = (next, f_next, j_next, err_next);
                         moved = true;
                         break;
@@ -524,7 +594,7 @@ impl OpenCvCamera {
                 break;
             }
         }
-        (err <= OPENCV_INVERSE_TOLERANCE_PX
+        (((f - target) * scale).abs().max_element() <= OPENCV_INVERSE_TOLERANCE_PX
             && q.length() < self.r_max
             && jacobian.determinant() > 0.0)
             .then_some(q)

@@ -4,8 +4,8 @@ use crate::camera::{Camera, CameraBase, CameraRay, CameraRayDifferential, Camera
 use crate::error::CameraError;
 use crate::film::{FilmGeometry, Shutter};
 use crate::opencv::{
-    OpenCvIntrinsics, camera_point, check_distortion, differential_of, fixed_pose, flip_y,
-    pose_at, sample_is_finite, world_ray,
+    OpenCvIntrinsics, camera_point, check_distortion, differential_of, fixed_pose, flip_y, pose_at,
+    sample_is_finite, world_ray,
 };
 use core::f64::consts::PI;
 use glam::{DVec2, DVec3};

@@ -10,6 +10,7 @@
 mod environment;
 mod exact;
 mod motion;
+mod opencv;
 mod projective;
 mod sample_use;
 mod thin_lens;

@@ -14,7 +14,7 @@ pub fn chain(camera: &AnyCamera) -> &ProjectiveCamera {
     match camera {
         AnyCamera::Perspective(c) => c.projective(),
         AnyCamera::Orthographic(c) => c.projective(),
-        AnyCamera::Environment(_) => panic!("not a projective camera"),
+        _ => panic!("not a projective camera"),
     }
 }
 
