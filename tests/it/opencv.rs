@@ -214,8 +214,15 @@ fn opencv_models_match_cv2() {
                 )))
                 .unwrap_or_else(|| panic!("no ray through {raster:?}"))
                 .ray;
-            let to_point = (p.to_glam() - eye).normalize();
-            let angle = f64::from(ray.direction.to_glam().angle_between(to_point));
+            // The angle from |a x b| in f64 (an f32 acos of a dot product near 1 is too coarse).
+            let to_point = (p.to_glam() - eye).as_dvec3().normalize();
+            let angle = ray
+                .direction
+                .to_glam()
+                .as_dvec3()
+                .normalize()
+                .cross(to_point)
+                .length();
             assert!(
                 angle < 2e-5,
                 "ray through {raster:?} misses {p:?} by {angle} rad"

@@ -42,13 +42,13 @@ pub struct DepthOfField {
 }
 
 impl DepthOfField {
-    /// The parameters of a projective camera's own lens and film. Errors: an environment camera
+    /// The parameters of a projective camera's own lens and film. Errors: any other camera
     /// (it has no thin lens).
     pub fn for_camera(camera: &AnyCamera) -> Result<DepthOfField, RenderError> {
         let (projective, orthographic) = match camera {
             AnyCamera::Perspective(c) => (c.projective(), false),
             AnyCamera::Orthographic(c) => (c.projective(), true),
-            AnyCamera::Environment(_) => {
+            _ => {
                 return Err(RenderError::Setting {
                     name: "camera",
                     message: "depth of field post-processing needs a perspective or \
