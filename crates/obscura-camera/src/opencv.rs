@@ -151,7 +151,8 @@ pub fn opencv_pose(
         camera_from_world.z_axis.extend(0.0),
         (flip * t).extend(1.0),
     );
-    if !(m.is_finite() && m_inv.is_finite()) || !m.as_mat4().is_finite() {
+    // Finite inputs give finite f64 matrices; a huge tvec can still overflow f32.
+    if !(m.as_mat4().is_finite() && m_inv.as_mat4().is_finite()) {
         return Err(CameraError::NonFinite {
             what: "tvec",
             got: f32::INFINITY,
@@ -526,7 +527,8 @@ impl OpenCvCamera {
     /// The distorted normalised point `(x'', y'')` of an undistorted `(x', y')` (OpenCV frame),
     /// or None outside the valid region (`r >= r_max`, or where the map folds).
     pub fn distort(&self, q: DVec2) -> Option<DVec2> {
-        if !(q.length() < self.r_max) {
+        let r = q.length();
+        if r.is_nan() || r >= self.r_max {
             return None;
         }
         let (d, jacobian) = self.distortion.apply(q);

@@ -172,7 +172,7 @@ impl OpenCvFisheyeCamera {
         let p_cv = flip_y(p);
         let r = p_cv.x.hypot(p_cv.y);
         let theta = r.atan2(p_cv.z);
-        if !(theta < self.theta_max) {
+        if theta.is_nan() || theta >= self.theta_max {
             return None;
         }
         let q = if r > 0.0 {

@@ -225,8 +225,7 @@ fn rvec_tvec_pose_by_hand() {
     let shutter = Shutter::new(0.0, 1.0).unwrap();
     let film = obscura_camera::FilmGeometry::new([640, 480], None, None).unwrap();
     let pose = opencv_pose([0.0, 0.0, core::f64::consts::FRAC_PI_2], [0.1, -0.2, 3.0]).unwrap();
-    let camera =
-        OpenCvCamera::new(CameraBase::new(pose, shutter, film.clone()), K, &[0.0; 4]).unwrap();
+    let camera = OpenCvCamera::new(CameraBase::new(pose, shutter, film), K, &[0.0; 4]).unwrap();
     // World (0.25, -0.5, 0): R turns (x, y) into (-y, x): (0.5, 0.25, 0); + t = (0.6, 0.05, 3).
     // u = 500 * 0.6 / 3 + 320 = 420, v = 400 * 0.05 / 3 + 240 = 246.666...; raster +0.5.
     let p = camera.project(Point3::new(0.25, -0.5, 0.0), 0.0).unwrap();
