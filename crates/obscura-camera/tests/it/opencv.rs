@@ -534,6 +534,11 @@ fn check_differential(camera: &AnyCamera, fx: f32, fy: f32) -> Result<(), TestCa
         // Composite Simpson over 8 sub-intervals: weights 1 4 2 4 2 4 2 4 1, over 24.
         let mut simpson = glam::Vec3::ZERO;
         let mut complete = true;
+        // The largest change of the tangent between sub-samples: Simpson's error (and the
+        // central differences') grows with it next to the fold, where the inverse's slope
+        // diverges.
+        let mut variation = 0.0f32;
+        let mut previous: Option<glam::Vec3> = None;
         for i in 0..=8 {
             let weight = if i == 0 || i == 8 {
                 1.0
@@ -543,7 +548,13 @@ fn check_differential(camera: &AnyCamera, fx: f32, fy: f32) -> Result<(), TestCa
                 2.0
             };
             match tangent(i as f32 / 8.0, axis) {
-                Some(t) => simpson += weight / 24.0 * t,
+                Some(t) => {
+                    simpson += weight / 24.0 * t;
+                    if let Some(prev) = previous {
+                        variation = variation.max((t - prev).length());
+                    }
+                    previous = Some(t);
+                }
                 None => complete = false,
             }
         }
@@ -552,7 +563,7 @@ fn check_differential(camera: &AnyCamera, fx: f32, fy: f32) -> Result<(), TestCa
         }
         let step = got - d;
         prop_assert!(
-            (step - simpson).length() <= 0.01 * step.length() + 2e-5,
+            (step - simpson).length() <= 0.01 * step.length() + 0.1 * variation + 2e-5,
             "step {step:?} vs Simpson's integral of the tangents {simpson:?}"
         );
     }
