@@ -3,6 +3,7 @@
 
 mod cli;
 mod gallery;
+mod opencv;
 mod robust;
 mod scenes;
 

@@ -8,6 +8,8 @@ use crate::film::{FilmGeometry, Shutter};
 use crate::fisheye::FisheyeCamera;
 use crate::octahedral::OctahedralCamera;
 use crate::ods::OdsCamera;
+use crate::opencv::OpenCvCamera;
+use crate::opencv_fisheye::OpenCvFisheyeCamera;
 use crate::orthographic::OrthographicCamera;
 use crate::perspective::PerspectiveCamera;
 use obscura_space::{AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, World};
@@ -31,6 +33,10 @@ pub enum AnyCamera {
     CubeFace(CubeFaceCamera),
     /// An omni-directional stereo panorama camera.
     Ods(OdsCamera),
+    /// An OpenCV pinhole camera with distortion.
+    OpenCv(OpenCvCamera),
+    /// An OpenCV (Kannala-Brandt) fisheye camera.
+    OpenCvFisheye(OpenCvFisheyeCamera),
 }
 
 macro_rules! dispatch {
@@ -44,6 +50,8 @@ macro_rules! dispatch {
             AnyCamera::Octahedral($c) => $e,
             AnyCamera::CubeFace($c) => $e,
             AnyCamera::Ods($c) => $e,
+            AnyCamera::OpenCv($c) => $e,
+            AnyCamera::OpenCvFisheye($c) => $e,
         }
     };
 }
@@ -121,5 +129,15 @@ impl From<CubeFaceCamera> for AnyCamera {
 impl From<OdsCamera> for AnyCamera {
     fn from(c: OdsCamera) -> Self {
         AnyCamera::Ods(c)
+    }
+}
+impl From<OpenCvCamera> for AnyCamera {
+    fn from(c: OpenCvCamera) -> Self {
+        AnyCamera::OpenCv(c)
+    }
+}
+impl From<OpenCvFisheyeCamera> for AnyCamera {
+    fn from(c: OpenCvFisheyeCamera) -> Self {
+        AnyCamera::OpenCvFisheye(c)
     }
 }

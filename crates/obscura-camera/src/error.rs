@@ -110,6 +110,20 @@ pub enum CameraError {
         /// The value given.
         got: f32,
     },
+    /// A focal length (`fx` or `fy`, in pixels) that is not positive.
+    FocalLength {
+        /// The parameter's name, `"fx"` or `"fy"`.
+        what: &'static str,
+        /// The value given.
+        got: f64,
+    },
+    /// A distortion list of a length the model does not read.
+    DistortionLength {
+        /// The camera type, `"opencv"` or `"opencv_fisheye"`.
+        model: &'static str,
+        /// The number of entries given.
+        got: usize,
+    },
 }
 
 impl fmt::Display for CameraError {
@@ -205,6 +219,20 @@ impl fmt::Display for CameraError {
             ),
             CameraError::Interaxial { got } => {
                 write!(f, "interaxial must be >= 0, got {got}")
+            }
+            CameraError::FocalLength { what, got } => {
+                write!(f, "{what} must be > 0 pixels, got {got}")
+            }
+            CameraError::DistortionLength { model, got } => {
+                let lengths = if *model == "opencv" {
+                    "4, 5, 8 or 12"
+                } else {
+                    "4"
+                };
+                write!(
+                    f,
+                    "distortion of an {model} camera must have {lengths} entries, got {got}"
+                )
             }
         }
     }

@@ -73,6 +73,8 @@ mod film;
 mod fisheye;
 mod octahedral;
 mod ods;
+mod opencv;
+mod opencv_fisheye;
 mod orthographic;
 mod perspective;
 mod projective;
@@ -90,6 +92,10 @@ pub use film::{FilmGeometry, FovAxis, MAX_RESOLUTION, ScreenWindow, Shutter};
 pub use fisheye::{FisheyeCamera, FisheyeProjection};
 pub use octahedral::OctahedralCamera;
 pub use ods::{OdsCamera, OdsEye};
+pub use opencv::{
+    OPENCV_INVERSE_TOLERANCE_PX, OPENCV_MAX_RADIUS, OpenCvCamera, OpenCvIntrinsics, opencv_pose,
+};
+pub use opencv_fisheye::{FISHEYE_INVERSE_TOLERANCE_PX, OpenCvFisheyeCamera};
 pub use orthographic::OrthographicCamera;
 pub use perspective::PerspectiveCamera;
 pub use projective::ProjectiveCamera;

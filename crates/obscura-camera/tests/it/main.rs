@@ -15,6 +15,7 @@ mod fisheye;
 mod motion;
 mod octahedral;
 mod ods;
+mod opencv;
 mod projective;
 mod ray_checks;
 mod sample_use;
