@@ -179,16 +179,16 @@ impl Camera for OrthographicCamera {
     #[inline]
     fn generate_ray(&self, sample: &CameraSample) -> Option<CameraRay> {
         let time = ray_time(self.shutter(), sample)?;
-        let moving;
-        let cache = match &self.fixed {
-            Some(cache) => cache,
+        // The call in each arm (not through one merged cache reference) lets LLVM keep the
+        // fixed cache's fields where they are.
+        let mut ray = match &self.fixed {
+            Some(cache) => self.ray(cache, sample.p_film, sample.p_lens),
             None => {
                 let base = self.projective.base();
-                moving = Self::cache(base, &base.frame_at(time));
-                &moving
+                let cache = Self::cache(base, &base.frame_at(time));
+                self.ray(&cache, sample.p_film, sample.p_lens)
             }
         };
-        let mut ray = self.ray(cache, sample.p_film, sample.p_lens);
         ray.time = time;
         Some(CameraRay { ray, weight: 1.0 })
     }

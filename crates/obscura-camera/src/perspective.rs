@@ -215,15 +215,16 @@ impl Camera for PerspectiveCamera {
     #[inline]
     fn generate_ray(&self, sample: &CameraSample) -> Option<CameraRay> {
         let time = ray_time(self.shutter(), sample)?;
-        let moving;
-        let cache = match &self.fixed {
-            Some(cache) => cache,
-            None => {
-                moving = Self::cache(&self.projective.base().frame_at(time));
-                &moving
-            }
+        // The call in each arm (not through one merged cache reference) lets LLVM keep the
+        // fixed cache's fields where they are.
+        let mut ray = match &self.fixed {
+            Some(cache) => self.ray(cache, sample.p_film, sample.p_lens),
+            None => self.ray(
+                &Self::cache(&self.projective.base().frame_at(time)),
+                sample.p_film,
+                sample.p_lens,
+            ),
         };
-        let mut ray = self.ray(cache, sample.p_film, sample.p_lens);
         ray.time = time;
         Some(CameraRay { ray, weight: 1.0 })
     }
