@@ -144,17 +144,12 @@ impl Camera for EnvironmentCamera {
     #[inline]
     fn generate_ray_differential(&self, sample: &CameraSample) -> Option<CameraRayDifferential> {
         let time = ray_time(self.base.shutter, sample)?;
-        let moving;
-        let cache = match &self.fixed {
-            Some(cache) => cache,
-            None => {
-                moving = Self::cache(&self.base.frame_at(time));
-                &moving
-            }
-        };
-        Some(differential_of(sample, time, |p_film| {
-            self.ray(cache, p_film)
-        }))
+        // As in generate_ray: the call in each arm keeps the fixed cache read in place.
+        let rays = |cache: &_| differential_of(sample, time, |p_film| self.ray(cache, p_film));
+        Some(match &self.fixed {
+            Some(cache) => rays(cache),
+            None => rays(&Self::cache(&self.base.frame_at(time))),
+        })
     }
 
     fn project(&self, p: Point3<World>, time: f32) -> Option<Point2<Raster>> {

@@ -196,18 +196,19 @@ impl Camera for OrthographicCamera {
     #[inline]
     fn generate_ray_differential(&self, sample: &CameraSample) -> Option<CameraRayDifferential> {
         let time = ray_time(self.shutter(), sample)?;
-        let moving;
-        let cache = match &self.fixed {
-            Some(cache) => cache,
-            None => {
-                let base = self.projective.base();
-                moving = Self::cache(base, &base.frame_at(time));
-                &moving
-            }
+        // As in generate_ray: the call in each arm keeps the fixed cache read in place.
+        let rays = |cache: &_| {
+            differential_of(sample, time, |p_film| {
+                self.ray(cache, p_film, sample.p_lens)
+            })
         };
-        Some(differential_of(sample, time, |p_film| {
-            self.ray(cache, p_film, sample.p_lens)
-        }))
+        Some(match &self.fixed {
+            Some(cache) => rays(cache),
+            None => rays(&{
+                let base = self.projective.base();
+                Self::cache(base, &base.frame_at(time))
+            }),
+        })
     }
 
     fn project(&self, p: Point3<World>, time: f32) -> Option<Point2<Raster>> {
