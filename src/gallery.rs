@@ -131,7 +131,7 @@ fn make_figure(out_dir: &Path, figure: Figure, quality: Quality) -> Result<Made,
             .iter()
             .map(|&r| {
                 let mut d = base.clone();
-                d.camera.lens_radius = r;
+                d.camera.lens.radius = r;
                 shoot(d)
             })
             .collect::<Result<_, _>>()?,
@@ -139,7 +139,7 @@ fn make_figure(out_dir: &Path, figure: Figure, quality: Quality) -> Result<Made,
             .iter()
             .map(|&f| {
                 let mut d = base.clone();
-                d.camera.focal_distance = f;
+                d.camera.lens.focal_distance = f;
                 shoot(d)
             })
             .collect::<Result<_, _>>()?,
@@ -209,8 +209,8 @@ fn compare(base: SceneDescription, defocus: bool) -> Result<(Image, Image), Rend
     let buffers = screen_buffers(&scene);
     // The pinhole image: no lens, and an instant shutter at the scene's shutter open.
     let mut pinhole = base;
-    pinhole.camera.lens_radius = 0.0;
-    pinhole.camera.shutter[1] = pinhole.camera.shutter[0];
+    pinhole.camera.lens.radius = 0.0;
+    pinhole.camera.shutter.close = pinhole.camera.shutter.open;
     let sharp = render_scene(&RenderScene::build(pinhole)?)?;
     let post = if defocus {
         let params = DepthOfField::for_camera(&scene.camera)?;

@@ -410,10 +410,10 @@ fn run_check(scene_path: &Path) -> Result<(), RenderError> {
         obscura_render::CameraKind::Environment => "environment",
     };
     let lens =
-        if d.camera.lens_radius > 0.0 && d.camera.kind != obscura_render::CameraKind::Environment {
+        if d.camera.lens.radius > 0.0 && d.camera.kind != obscura_render::CameraKind::Environment {
             format!(
                 " with a thin lens (radius {}, focused at {})",
-                d.camera.lens_radius, d.camera.focal_distance
+                d.camera.lens.radius, d.camera.lens.focal_distance
             )
         } else {
             String::new()

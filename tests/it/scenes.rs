@@ -61,8 +61,8 @@ fn depth_at_a_sphere_centre_is_the_analytic_distance() {
     );
     d.film.filter = FilterSettings::Box { radius: 0.5 };
     let scene = RenderScene::build(d.clone()).unwrap();
-    let eye = Vec3::from(d.camera.start.eye);
-    let view = (Vec3::from(d.camera.start.target) - eye).normalize();
+    let eye = d.camera.start.eye.to_glam();
+    let view = (d.camera.start.target.to_glam() - eye).normalize();
     for (center, radius) in [
         ([0.0, 0.7, 0.0], 0.7),
         ([-1.6, 0.7, -1.5], 0.7),
@@ -135,7 +135,7 @@ fn thin_lens_keeps_the_focused_sphere_sharp_and_blurs_the_near_one() {
     let scene = RenderScene::build(d.clone()).unwrap();
     let lens = render_image(d.clone(), 2);
     let mut pinhole = d.clone();
-    pinhole.camera.lens_radius = 0.0;
+    pinhole.camera.lens.radius = 0.0;
     let pinhole = render_image(pinhole, 2);
 
     // The green sphere (in focus) and its right edge; the blue one (near) and its left edge.
@@ -150,7 +150,7 @@ fn thin_lens_keeps_the_focused_sphere_sharp_and_blurs_the_near_one() {
     let c = &d.camera;
     let z_blue = 4.569f32;
     let pixels_per_unit = 240.0 / (2.0 * 20f32.to_radians().tan());
-    let coc = c.lens_radius * (1.0 / z_blue - 1.0 / c.focal_distance) * pixels_per_unit;
+    let coc = c.lens.radius * (1.0 / z_blue - 1.0 / c.lens.focal_distance) * pixels_per_unit;
     // A disc-blurred edge climbs from 10% to 90% over about 1.3 coc pixels.
     let band = 1.3 * coc;
     assert!(
@@ -186,7 +186,7 @@ fn motion_blur_smears_the_moving_sphere_by_its_screen_motion_only() {
     let scene = RenderScene::build(d.clone()).unwrap();
     let moving = render_image(d.clone(), 2);
     let mut still = d.clone();
-    still.camera.shutter = [0.0, 0.0];
+    still.camera.shutter = obscura_camera::Shutter::new(0.0, 0.0).unwrap();
     let still = render_image(still, 2);
 
     let open = scene

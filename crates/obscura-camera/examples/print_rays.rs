@@ -5,14 +5,15 @@
 
 use obscura_camera::{
     AnyCamera, Camera, CameraBase, CameraError, CameraSample, EnvironmentCamera, FilmGeometry,
-    FovAxis, OrthographicCamera, PerspectiveCamera, ScreenWindow, Shutter, ThinLens, look_at_pose,
+    FovAxis, LookAt, OrthographicCamera, PerspectiveCamera, ScreenWindow, Shutter, ThinLens,
+    look_at_pose,
 };
 use obscura_space::{Point2, Point3, Vector3};
 
 fn main() -> Result<(), CameraError> {
     let resolution = [4, 3];
     let shutter = Shutter::new(0.0, 1.0)?;
-    let look = (
+    let look = LookAt::new(
         Point3::new(0.0, 1.0, 5.0),
         Point3::new(0.0, 0.0, 0.0),
         Vector3::new(0.0, 1.0, 0.0),

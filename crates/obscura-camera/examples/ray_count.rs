@@ -13,7 +13,7 @@
 //! with a `-moving` suffix (the eye slides along x over the shutter).
 
 use obscura_camera::{
-    AnyCamera, Camera, CameraBase, CameraSample, EnvironmentCamera, FilmGeometry, FovAxis,
+    AnyCamera, Camera, CameraBase, CameraSample, EnvironmentCamera, FilmGeometry, FovAxis, LookAt,
     OrthographicCamera, PerspectiveCamera, Shutter, ThinLens, look_at_pose,
 };
 use obscura_space::{Point2, Point3, Vector3};
@@ -25,12 +25,15 @@ fn camera(name: &str) -> Option<AnyCamera> {
         None => (name, false),
     };
     let shutter = Shutter::new(0.0, 1.0).ok()?;
-    let start = (
+    let start = LookAt::new(
         Point3::new(0.0, 1.0, 5.0),
         Point3::new(0.0, 0.0, 0.0),
         Vector3::new(0.0, 1.0, 0.0),
     );
-    let end = (Point3::new(1.0, 1.0, 5.0), start.1, start.2);
+    let end = LookAt {
+        eye: Point3::new(1.0, 1.0, 5.0),
+        ..start
+    };
     let base = CameraBase::new(
         look_at_pose(start, moving.then_some(end), shutter).ok()?,
         shutter,

@@ -2,8 +2,9 @@
 //! the pose, the shutter, the film and the clip range.
 
 use crate::error::{CameraError, finite};
-use crate::film::{FilmGeometry, Shutter, validate_near_far};
+use crate::film::{FilmGeometry, Shutter, validate_clip};
 use glam::DVec3;
+use obscura_sample::SampleStream;
 use obscura_space::{
     AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, Ray, Transform, Vector3,
     World,
@@ -26,6 +27,27 @@ pub struct CameraSample {
 }
 
 impl CameraSample {
+    /// The sample of pixel `pixel` drawn from `stream`: the film position inside the pixel,
+    /// the lens sample only when `lens` and the time only when `time` (else the lens centre
+    /// and time 0, as [`CameraSample::at`]), from the stream's camera dimensions (see
+    /// [`SampleStream::camera_with`]). Pass the camera's [`Camera::uses_lens_sample`] and
+    /// [`Camera::uses_time_sample`]: a dimension the camera ignores is then not computed.
+    #[inline]
+    pub fn from_stream(
+        stream: &mut SampleStream<'_>,
+        pixel: [u32; 2],
+        lens: bool,
+        time: bool,
+    ) -> CameraSample {
+        let (film, p_lens, time) = stream.camera_with(lens, time);
+        let p_film = glam::Vec2::new(pixel[0] as f32, pixel[1] as f32) + film;
+        CameraSample {
+            p_film: Point2::from_glam(p_film),
+            p_lens,
+            time,
+        }
+    }
+
     /// A sample at a film position through the lens centre at shutter open: what a pinhole
     /// camera needs.
     pub fn at(p_film: Point2<Raster>) -> Self {
@@ -108,6 +130,9 @@ pub trait Camera: Send + Sync {
     }
 }
 
+/// The most aperture blades a [`ThinLens`] takes (more is indistinguishable from round).
+pub const MAX_BLADES: u32 = 64;
+
 /// A thin lens: the aperture radius, the distance of the plane in focus, and the aperture's
 /// shape.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -116,7 +141,7 @@ pub struct ThinLens {
     pub radius: f32,
     /// Camera-space z of the plane in perfect focus; > 0.
     pub focal_distance: f32,
-    /// Aperture blades: 0 for a round aperture, else at least 3 (a regular polygon).
+    /// Aperture blades: 0 for a round aperture, else 3 to [`MAX_BLADES`] (a regular polygon).
     pub blades: u32,
     /// Rotation of the polygonal aperture in degrees, counter-clockwise from camera +x.
     pub rotation_degrees: f32,
@@ -155,7 +180,7 @@ impl ThinLens {
     }
 
     /// Checks the parameters: finite numbers, `radius >= 0`, `focal_distance > 0`, `blades` 0
-    /// or at least 3.
+    /// or 3 to [`MAX_BLADES`].
     pub fn validate(&self) -> Result<(), CameraError> {
         finite("lens_radius", self.radius)?;
         finite("focal_distance", self.focal_distance)?;
@@ -168,7 +193,7 @@ impl ThinLens {
                 got: self.focal_distance,
             });
         }
-        if self.blades == 1 || self.blades == 2 {
+        if self.blades == 1 || self.blades == 2 || self.blades > MAX_BLADES {
             return Err(CameraError::Blades { got: self.blades });
         }
         Ok(())
@@ -236,21 +261,65 @@ impl CameraBase {
         CameraBase { near, far, ..self }
     }
 
-    /// Checks the shutter and the clip range; `positive_near` refuses `near == 0`.
+    /// Checks the pose, the shutter and the clip range; `positive_near` refuses `near == 0`.
+    /// The pose must be affine at every keyframe (a projective pose has no camera frame to
+    /// build rays from; look-at poses and their interpolations are always affine).
     pub(crate) fn validate(&self, positive_near: bool) -> Result<(), CameraError> {
+        if self
+            .world_from_camera
+            .keyframes()
+            .any(|(_, key)| key.matrix().row(3) != glam::Vec4::W)
+        {
+            return Err(CameraError::ProjectivePose);
+        }
         Shutter::new(self.shutter.open, self.shutter.close)?;
-        validate_near_far(self.near, self.far, positive_near)
+        validate_clip(self.near, self.far, positive_near)
     }
 
-    /// The pose at `time`; the hot path skips the interpolation for a fixed camera.
+    /// The pose at `time`, with its inverse (for `project`).
     #[inline]
     pub(crate) fn pose(&self, time: f32) -> Transform<World, CameraSpace> {
         self.world_from_camera.at(time)
     }
+
+    /// The camera frame of the pose at `time`: the forward matrix only (a moving pose skips
+    /// the interpolated inverse). Affine, as [`CameraBase::validate`] checked.
+    #[inline]
+    pub(crate) fn frame_at(&self, time: f32) -> PoseFrame {
+        PoseFrame::of(self.world_from_camera.matrix_at(time))
+    }
+
+    /// The camera frame of a fixed pose, None for a moving one: what the models turn into
+    /// their per-pose cache at construction.
+    pub(crate) fn fixed_frame(&self) -> Option<PoseFrame> {
+        (!self.world_from_camera.is_animated()).then(|| self.frame_at(0.0))
+    }
 }
 
-/// A look-at: eye, target and up, in world space.
-pub type LookAt = (Point3<World>, Point3<World>, Vector3<World>);
+/// A look-at: the camera at `eye` looks towards `target`, with `up` towards the image's top.
+/// World space throughout.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LookAt {
+    /// The camera position.
+    pub eye: Point3<World>,
+    /// A point the camera looks at (the image centre).
+    pub target: Point3<World>,
+    /// The up direction; need not be unit length or orthogonal to the view.
+    pub up: Vector3<World>,
+}
+
+impl LookAt {
+    /// The look-at from `eye` towards `target` with `up`.
+    pub const fn new(eye: Point3<World>, target: Point3<World>, up: Vector3<World>) -> LookAt {
+        LookAt { eye, target, up }
+    }
+
+    /// The camera pose of this look-at. Errors: `eye == target`, `up` parallel to the view,
+    /// non-finite numbers.
+    pub fn pose(&self) -> Result<Transform<World, CameraSpace>, CameraError> {
+        Ok(Transform::look_at(self.eye, self.target, self.up)?)
+    }
+}
 
 /// Camera pose from look-at at shutter open and, optionally, at shutter close (the scene
 /// format's `eye_end`, `target_end`, `up_end`). The result is fixed when `end` is None or the
@@ -264,10 +333,10 @@ pub fn look_at_pose(
     end: Option<LookAt>,
     shutter: Shutter,
 ) -> Result<AnimatedTransform<World, CameraSpace>, CameraError> {
-    let start_pose = Transform::look_at(start.0, start.1, start.2)?;
+    let start_pose = start.pose()?;
     match end {
         Some(end) if shutter.open < shutter.close => {
-            let end_pose = Transform::look_at(end.0, end.1, end.2)?;
+            let end_pose = end.pose()?;
             Ok(AnimatedTransform::new(
                 start_pose,
                 shutter.open,
@@ -276,26 +345,6 @@ pub fn look_at_pose(
             )?)
         }
         _ => Ok(AnimatedTransform::fixed(start_pose)),
-    }
-}
-
-/// Moves a camera-space ray to world space with `pose`, keeping the direction unit length.
-/// A rigid pose (a look-at) changes lengths only by rounding: the direction is renormalised and
-/// `t` kept, so the clip range stays exactly `[near, far]`. A pose with scale would stretch the
-/// direction: then the `t` range is rescaled too, to keep the same points.
-#[inline]
-pub(crate) fn to_world(pose: &Transform<World, CameraSpace>, ray: Ray<CameraSpace>) -> Ray<World> {
-    let ray = pose.ray(ray);
-    let length = ray.direction.length();
-    let direction = ray.direction / length;
-    if is_unit_length(length) {
-        return Ray { direction, ..ray };
-    }
-    Ray {
-        direction,
-        t_min: ray.t_min * length,
-        t_max: ray.t_max * length,
-        ..ray
     }
 }
 
@@ -331,19 +380,16 @@ pub(crate) struct PoseFrame {
 }
 
 impl PoseFrame {
-    /// The frame of an affine pose; None for a projective one (its bottom row is not
-    /// `[0 0 0 1]`), which then takes the general path.
+    /// The frame of an affine matrix (bottom row `[0 0 0 1]`, which [`CameraBase::validate`]
+    /// checks for every keyframe; interpolations of affine keyframes are affine).
     #[inline]
-    pub(crate) fn of(m: glam::Mat4) -> Option<PoseFrame> {
-        if m.row(3) != glam::Vec4::W {
-            return None;
-        }
-        Some(PoseFrame {
+    fn of(m: glam::Mat4) -> PoseFrame {
+        PoseFrame {
             x: m.x_axis.truncate().as_dvec3(),
             y: m.y_axis.truncate().as_dvec3(),
             z: m.z_axis.truncate().as_dvec3(),
             eye: m.w_axis.truncate().as_dvec3(),
-        })
+        }
     }
 }
 
@@ -354,52 +400,11 @@ pub(crate) fn is_unit_length(length: f32) -> bool {
     (length - 1.0).abs() <= 1e-5
 }
 
-/// A camera model: its camera-space rays (the general path, for any pose), and a fast path
-/// that goes straight from the film to world space through constants derived once per pose
-/// (once per camera when the pose is fixed, once per ray when it moves).
-///
-/// Both paths describe the same rays; they differ only by f32 rounding. A moving camera
-/// derives its constants at the ray's time with the same function a fixed camera uses at
-/// construction, so at a keyframe's time the two give bit-identical rays.
-pub(crate) trait CameraRayModel {
-    /// Per-pose constants of the fast path.
-    type WorldMap: Copy;
-
-    fn base(&self) -> &CameraBase;
-    /// Whether the rays depend on the lens sample (see [`Camera::uses_lens_sample`]).
-    fn uses_lens(&self) -> bool;
-    /// The camera-space ray (the general path, used for projective poses).
-    fn ray_camera(&self, p_film: Point2<Raster>, u_lens: glam::Vec2) -> Ray<CameraSpace>;
-    /// The fast path's constants for an affine pose.
-    fn world_map(&self, frame: &PoseFrame) -> Self::WorldMap;
-    /// The constants of the fixed pose, computed at construction (None when the pose moves
-    /// or is projective).
-    fn fixed_map(&self) -> Option<&Self::WorldMap>;
-    /// The world-space ray of a film point and lens sample (time 0) from the constants.
-    fn ray_world(
-        &self,
-        map: &Self::WorldMap,
-        p_film: Point2<Raster>,
-        u_lens: glam::Vec2,
-    ) -> Ray<World>;
-}
-
-/// The constants of a camera's pose if it is fixed and affine: what the cameras store at
-/// construction.
-pub(crate) fn fixed_map_of<M: CameraRayModel>(model: &M) -> Option<M::WorldMap> {
-    let pose = &model.base().world_from_camera;
-    if pose.is_animated() {
-        return None;
-    }
-    PoseFrame::of(pose.matrix_at(0.0)).map(|frame| model.world_map(&frame))
-}
-
 /// True when every number of the sample is finite.
 ///
-/// One test instead of five: `0 * v` is (signed) 0 for finite `v` and NaN for an infinity or
-/// NaN, so the sum of the five products is 0 exactly when all five are finite (NaN never
-/// compares equal, and sums of zeros cannot overflow). Branch-free, mostly in one SSE register: callgrind
-/// counts about 10 instructions per ray fewer than five short-circuit `is_finite` tests.
+/// One branch-free test instead of five: `0 * v` is (signed) 0 for finite `v` and NaN for an
+/// infinity or NaN, so the sum of the five products is 0 exactly when all five are finite (NaN
+/// never compares equal, and sums of zeros cannot overflow).
 #[inline]
 fn sample_is_finite(sample: &CameraSample) -> bool {
     let v = glam::Vec4::new(
@@ -411,124 +416,31 @@ fn sample_is_finite(sample: &CameraSample) -> bool {
     (v * 0.0).element_sum() + sample.time * 0.0 == 0.0
 }
 
-/// Calls `rays` with the constants of the pose at `time`, or (for a projective pose) falls back
-/// to camera-space rays moved by the pose.
+/// The time of a sample's ray on `shutter`, or None when a number of the sample is not finite
+/// (such a sample gives no ray): the first step of every model's `generate_ray`.
 #[inline]
-fn with_pose<M: CameraRayModel, R>(
-    model: &M,
-    time: f32,
-    rays: impl Fn(&dyn Fn(Point2<Raster>, glam::Vec2) -> Ray<World>) -> R,
-) -> R {
-    if let Some(map) = model.fixed_map() {
-        return rays(&|p_film, u_lens| model.ray_world(map, p_film, u_lens));
-    }
-    // Only the forward matrix: a moving pose skips the interpolated inverse.
-    let world_from_camera = &model.base().world_from_camera;
-    match PoseFrame::of(world_from_camera.matrix_at(time)) {
-        Some(frame) => {
-            let map = model.world_map(&frame);
-            rays(&|p_film, u_lens| model.ray_world(&map, p_film, u_lens))
-        }
-        None => {
-            let pose = model.base().pose(time);
-            rays(&|p_film, u_lens| to_world(&pose, model.ray_camera(p_film, u_lens)))
-        }
-    }
-}
-
-/// [`Camera::generate_ray`] for any model: time, then the world ray of the pose at that time.
-#[inline]
-pub(crate) fn generate<M: CameraRayModel>(model: &M, sample: &CameraSample) -> Option<CameraRay> {
+pub(crate) fn ray_time(shutter: Shutter, sample: &CameraSample) -> Option<f32> {
     if !sample_is_finite(sample) {
         return None;
     }
-    let time = model.base().shutter.time_at(sample.time);
-    let mut ray = match model.fixed_map() {
-        // The common case, without the closure machinery.
-        Some(map) => model.ray_world(map, sample.p_film, sample.p_lens),
-        None => with_pose(model, time, |ray| ray(sample.p_film, sample.p_lens)),
-    };
-    ray.time = time;
-    Some(CameraRay { ray, weight: 1.0 })
+    Some(shutter.time_at(sample.time))
 }
 
-/// [`Camera::generate_ray_differential`] for any model: the three rays share the lens sample,
-/// the time and the pose (evaluated once).
-#[inline]
-pub(crate) fn generate_differential<M: CameraRayModel>(
-    model: &M,
+/// The three rays of a differential, from a model's per-ray function `ray(p_film)` (the lens
+/// sample and pose cache already bound): the sample's film point and its neighbours one pixel
+/// right and one pixel down, all at `time`.
+#[inline(always)]
+pub(crate) fn differential_of(
     sample: &CameraSample,
-) -> Option<CameraRayDifferential> {
-    if !sample_is_finite(sample) {
-        return None;
-    }
-    let time = model.base().shutter.time_at(sample.time);
-    with_pose(model, time, |ray| {
-        let world = |dx: f32, dy: f32| {
-            let p_film = Point2::new(sample.p_film.x + dx, sample.p_film.y + dy);
-            Ray {
-                time,
-                ..ray(p_film, sample.p_lens)
-            }
-        };
-        Some(differential(
-            world(0.0, 0.0),
-            world(1.0, 0.0),
-            world(0.0, 1.0),
-        ))
-    })
-}
-
-/// Implements [`Camera`] for a model: rays through [`generate`] and [`generate_differential`],
-/// film, shutter and pose from its [`CameraBase`], and `project` from the model's own
-/// `$project(&self, p_world, time)` method. One definition for the three models' plumbing.
-macro_rules! camera_via_model {
-    ($ty:ty, $project:ident) => {
-        impl $crate::camera::Camera for $ty {
-            #[inline]
-            fn generate_ray(
-                &self,
-                sample: &$crate::camera::CameraSample,
-            ) -> Option<$crate::camera::CameraRay> {
-                $crate::camera::generate(self, sample)
-            }
-            #[inline]
-            fn generate_ray_differential(
-                &self,
-                sample: &$crate::camera::CameraSample,
-            ) -> Option<$crate::camera::CameraRayDifferential> {
-                $crate::camera::generate_differential(self, sample)
-            }
-            fn project(
-                &self,
-                p: obscura_space::Point3<obscura_space::World>,
-                time: f32,
-            ) -> Option<obscura_space::Point2<obscura_space::Raster>> {
-                self.$project(p, time)
-            }
-            #[inline]
-            fn film(&self) -> &$crate::film::FilmGeometry {
-                &$crate::camera::CameraRayModel::base(self).film
-            }
-            #[inline]
-            fn shutter(&self) -> $crate::film::Shutter {
-                $crate::camera::CameraRayModel::base(self).shutter
-            }
-            #[inline]
-            fn world_from_camera(
-                &self,
-            ) -> &obscura_space::AnimatedTransform<obscura_space::World, obscura_space::Camera>
-            {
-                &$crate::camera::CameraRayModel::base(self).world_from_camera
-            }
-            #[inline]
-            fn uses_lens_sample(&self) -> bool {
-                $crate::camera::CameraRayModel::uses_lens(self)
-            }
-        }
+    time: f32,
+    ray: impl Fn(Point2<Raster>) -> Ray<World>,
+) -> CameraRayDifferential {
+    let world = |dx: f32, dy: f32| Ray {
+        time,
+        ..ray(Point2::new(sample.p_film.x + dx, sample.p_film.y + dy))
     };
+    differential(world(0.0, 0.0), world(1.0, 0.0), world(0.0, 1.0))
 }
-pub(crate) use camera_via_model;
 
 #[cfg(test)]
 mod tests {
@@ -552,6 +464,11 @@ mod tests {
         let lens = ThinLens::new(0.1, 2.0).unwrap();
         assert!(lens.with_blades(2, 0.0).is_err());
         assert!(lens.with_blades(6, 15.0).is_ok());
+        assert!(lens.with_blades(MAX_BLADES, 0.0).is_ok());
+        assert!(matches!(
+            lens.with_blades(MAX_BLADES + 1, 0.0),
+            Err(CameraError::Blades { .. })
+        ));
     }
 
     #[test]
@@ -574,16 +491,16 @@ mod tests {
 
     #[test]
     fn look_at_pose_is_fixed_without_end_or_with_instant_shutter() {
-        let start = (
-            Point3::new(0.0, 0.0, 0.0),
-            Point3::new(0.0, 0.0, -1.0),
-            Vector3::new(0.0, 1.0, 0.0),
-        );
-        let end = (
-            Point3::new(1.0, 0.0, 0.0),
-            Point3::new(1.0, 0.0, -1.0),
-            Vector3::new(0.0, 1.0, 0.0),
-        );
+        let start = LookAt {
+            eye: Point3::new(0.0, 0.0, 0.0),
+            target: Point3::new(0.0, 0.0, -1.0),
+            up: Vector3::new(0.0, 1.0, 0.0),
+        };
+        let end = LookAt {
+            eye: Point3::new(1.0, 0.0, 0.0),
+            target: Point3::new(1.0, 0.0, -1.0),
+            ..start
+        };
         let shutter = Shutter::new(0.0, 1.0).unwrap();
         assert!(!look_at_pose(start, None, shutter).unwrap().is_animated());
         assert!(
@@ -597,7 +514,10 @@ mod tests {
                 .unwrap()
                 .is_animated()
         );
-        let bad = (start.0, start.0, start.2);
+        let bad = LookAt {
+            target: start.eye,
+            ..start
+        };
         assert!(matches!(
             look_at_pose(bad, None, shutter),
             Err(CameraError::Pose(_))

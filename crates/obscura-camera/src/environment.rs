@@ -1,11 +1,17 @@
 //! The environment (equirectangular) camera.
 
-use crate::camera::{CameraBase, CameraRayModel, PoseFrame, fixed_map_of, is_unit_length};
+use crate::camera::{
+    Camera, CameraBase, CameraRay, CameraRayDifferential, CameraSample, PoseFrame, differential_of,
+    is_unit_length, ray_time,
+};
 use crate::error::CameraError;
+use crate::film::{FilmGeometry, Shutter};
 use core::f32::consts::{PI, TAU};
 use glam::{Vec2, Vec3, Vec3A, Vec4};
 use obscura_sample::sin_cos_pi_vec4;
-use obscura_space::{Camera as CameraSpace, Point2, Point3, Raster, Ray, Vector3, World};
+use obscura_space::{
+    AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, Ray, Vector3, World,
+};
 
 /// A 360 x 180 degree camera: every ray starts at the eye, and raster `(x, y)` maps to the
 /// direction of SCENE_FORMAT.md, polar angle `theta = pi * y / height` from camera +y and
@@ -24,14 +30,14 @@ pub struct EnvironmentCamera {
     /// kept in units of pi, so that [`sin_cos_pi_vec4`] reduces them exactly and the poles and the
     /// image centre get exact sines and cosines).
     half_turns_per_raster: Vec2,
-    /// The fast path's constants of a fixed pose.
-    fixed: Option<EnvironmentMap>,
+    /// The pose cache of a fixed pose, computed once; None when the pose moves.
+    fixed: Option<EquirectFrame>,
 }
 
-/// Per-pose constants of the fast path: the world images of the camera axes, the eye, and
-/// whether the pose is rigid (then the clip range stays exactly `[near, far]`).
+/// The per-pose cache of [`EnvironmentCamera::ray`]: the world images of the camera axes, the
+/// eye, and whether the pose is rigid (then the clip range stays exactly `[near, far]`).
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct EnvironmentMap {
+struct EquirectFrame {
     x: Vec3A,
     y: Vec3A,
     z: Vec3A,
@@ -45,13 +51,11 @@ impl EnvironmentCamera {
     pub fn new(base: CameraBase) -> Result<EnvironmentCamera, CameraError> {
         base.validate(false)?;
         let [width, height] = base.film.resolution().map(|r| r as f32);
-        let mut camera = EnvironmentCamera {
+        Ok(EnvironmentCamera {
+            fixed: base.fixed_frame().map(|f| Self::cache(&f)),
             base,
             half_turns_per_raster: Vec2::new(2.0 / width, 1.0 / height),
-            fixed: None,
-        };
-        camera.fixed = fixed_map_of(&camera);
-        Ok(camera)
+        })
     }
 
     /// The pose, shutter, film and clip range.
@@ -74,36 +78,21 @@ impl EnvironmentCamera {
     }
 }
 
-impl CameraRayModel for EnvironmentCamera {
-    type WorldMap = EnvironmentMap;
-
+impl EnvironmentCamera {
+    /// The pose cache of a camera frame: the fixed pose's at construction, the pose's at the
+    /// ray's time for a moving camera (the same function, so a moving camera at a keyframe's
+    /// time gives the fixed camera's rays bit for bit).
     #[inline]
-    fn base(&self) -> &CameraBase {
-        &self.base
-    }
-
-    #[inline]
-    fn uses_lens(&self) -> bool {
-        false
-    }
-
-    #[inline]
-    fn ray_camera(&self, p_film: Point2<Raster>, _u_lens: glam::Vec2) -> Ray<CameraSpace> {
-        Ray::new(Point3::ORIGIN, self.direction(p_film), 0.0)
-            .with_range(self.base.near, self.base.far)
-    }
-
-    #[inline]
-    fn world_map(&self, frame: &PoseFrame) -> EnvironmentMap {
+    fn cache(frame: &PoseFrame) -> EquirectFrame {
         let (x, y, z) = (frame.x, frame.y, frame.z);
-        // Rigid: orthonormal axes up to f32 rounding (what `to_world` tests per ray).
+        // Rigid: orthonormal axes up to f32 rounding.
         let rigid = [x.length(), y.length(), z.length()]
             .iter()
             .all(|&l| is_unit_length(l as f32))
             && [x.dot(y), y.dot(z), z.dot(x)]
                 .iter()
                 .all(|d| d.abs() <= 1e-5);
-        EnvironmentMap {
+        EquirectFrame {
             x: x.as_vec3().into(),
             y: y.as_vec3().into(),
             z: z.as_vec3().into(),
@@ -112,25 +101,24 @@ impl CameraRayModel for EnvironmentCamera {
         }
     }
 
-    #[inline]
-    fn fixed_map(&self) -> Option<&EnvironmentMap> {
-        self.fixed.as_ref()
-    }
-
-    // Always: the per-ray body; left to LLVM it fell out of line once the aperture warp
-    // was inlined, costing a call and spills (perspective pinhole 84 -> 104 instructions).
+    /// The world ray of a film point (time 0): where this model's rays are built, for
+    /// `generate_ray` and the differentials alike. `cache` is the pose at the ray's time.
+    /// Inlined always: it is the per-ray body.
     #[inline(always)]
-    fn ray_world(&self, map: &EnvironmentMap, p_film: Point2<Raster>, _u_lens: Vec2) -> Ray<World> {
+    fn ray(&self, cache: &EquirectFrame, p_film: Point2<Raster>) -> Ray<World> {
+        // Film point -> camera direction: the equirectangular map (no lens, no projection).
         let d_camera = self.direction(p_film);
-        let w = map.x * d_camera.x + map.y * d_camera.y + map.z * d_camera.z;
+        // world_from_camera(t) of the direction, through the cache.
+        let w = cache.x * d_camera.x + cache.y * d_camera.y + cache.z * d_camera.z;
+        // Clip: [near, far] is a distance; a pose with scale stretches it.
         let length = w.length();
-        let (t_min, t_max) = if map.rigid {
+        let (t_min, t_max) = if cache.rigid {
             (self.base.near, self.base.far)
         } else {
             (self.base.near * length, self.base.far * length)
         };
         Ray {
-            origin: Point3::from_glam(Vec3::from(map.eye)),
+            origin: Point3::from_glam(Vec3::from(cache.eye)),
             direction: Vector3::from_glam(Vec3::from(w / length)),
             time: 0.0,
             t_min,
@@ -139,9 +127,32 @@ impl CameraRayModel for EnvironmentCamera {
     }
 }
 
-impl EnvironmentCamera {
-    /// The raster position of world point `p` at `time` (see [`Camera::project`](crate::Camera::project)).
-    fn project_world(&self, p: Point3<World>, time: f32) -> Option<Point2<Raster>> {
+impl Camera for EnvironmentCamera {
+    #[inline]
+    fn generate_ray(&self, sample: &CameraSample) -> Option<CameraRay> {
+        let time = ray_time(self.base.shutter, sample)?;
+        // The call in each arm (not through one merged cache reference) lets LLVM keep the
+        // fixed cache's fields where they are.
+        let mut ray = match &self.fixed {
+            Some(cache) => self.ray(cache, sample.p_film),
+            None => self.ray(&Self::cache(&self.base.frame_at(time)), sample.p_film),
+        };
+        ray.time = time;
+        Some(CameraRay { ray, weight: 1.0 })
+    }
+
+    #[inline]
+    fn generate_ray_differential(&self, sample: &CameraSample) -> Option<CameraRayDifferential> {
+        let time = ray_time(self.base.shutter, sample)?;
+        // As in generate_ray: the call in each arm keeps the fixed cache read in place.
+        let rays = |cache: &_| differential_of(sample, time, |p_film| self.ray(cache, p_film));
+        Some(match &self.fixed {
+            Some(cache) => rays(cache),
+            None => rays(&Self::cache(&self.base.frame_at(time))),
+        })
+    }
+
+    fn project(&self, p: Point3<World>, time: f32) -> Option<Point2<Raster>> {
         let camera_from_world = self.base.pose(time).inverse();
         let v_camera = camera_from_world.point(p).to_vector();
         let distance = v_camera.length();
@@ -154,6 +165,24 @@ impl EnvironmentCamera {
         let [width, height] = self.base.film.resolution().map(|r| r as f32);
         Some(Point2::new(width * (phi / TAU + 0.5), height * theta / PI))
     }
-}
 
-crate::camera::camera_via_model!(EnvironmentCamera, project_world);
+    #[inline]
+    fn film(&self) -> &FilmGeometry {
+        &self.base.film
+    }
+
+    #[inline]
+    fn shutter(&self) -> Shutter {
+        self.base.shutter
+    }
+
+    #[inline]
+    fn world_from_camera(&self) -> &AnimatedTransform<World, CameraSpace> {
+        &self.base.world_from_camera
+    }
+
+    #[inline]
+    fn uses_lens_sample(&self) -> bool {
+        false
+    }
+}

@@ -265,7 +265,10 @@ impl FilmGeometry {
 
 /// Checks the clip range shared by all cameras: finite, `0 <= near < far` (`0 < near` when
 /// `positive`).
-pub(crate) fn validate_near_far(near: f32, far: f32, positive: bool) -> Result<(), CameraError> {
+/// Checks a clip range: finite, `near >= 0` (`> 0` when `positive`, as a perspective camera
+/// needs), `near < far`. What the camera constructors check; public so that a scene layer can
+/// check its keys before building a camera.
+pub fn validate_clip(near: f32, far: f32, positive: bool) -> Result<(), CameraError> {
     finite("near", near)?;
     finite("far", far)?;
     if near < 0.0 || (positive && near == 0.0) {
@@ -351,10 +354,10 @@ mod tests {
 
     #[test]
     fn near_far_rules() {
-        assert!(validate_near_far(0.0, 1.0, false).is_ok());
-        assert!(validate_near_far(0.0, 1.0, true).is_err());
-        assert!(validate_near_far(1.0, 1.0, false).is_err());
-        assert!(validate_near_far(-1.0, 1.0, false).is_err());
-        assert!(validate_near_far(0.1, f32::INFINITY, false).is_err());
+        assert!(validate_clip(0.0, 1.0, false).is_ok());
+        assert!(validate_clip(0.0, 1.0, true).is_err());
+        assert!(validate_clip(1.0, 1.0, false).is_err());
+        assert!(validate_clip(-1.0, 1.0, false).is_err());
+        assert!(validate_clip(0.1, f32::INFINITY, false).is_err());
     }
 }

@@ -29,24 +29,27 @@
 //! +y up, +x the image's right, which makes the camera frame left-handed in a right-handed
 //! world.
 //!
-//! Speed: rays do not go through the 4x4 chain one by one. Each model reduces the film-to-camera
-//! map and the pose's affine part to a few constants (for a perspective pinhole, the film point
-//! `q` on the camera plane z = 1 is affine in raster x, y and the world direction is `R q`, then
-//! one normalisation), computed once for a
-//! fixed pose and once per ray for a moving one, with the same function, so a moving camera
-//! at a keyframe's time gives the fixed camera's rays bit for bit. The transforms stay the
-//! reference: [`ProjectiveCamera`] exposes them, and `project` uses them.
+//! Rays: each model builds them in one function (`ray`, private), used by
+//! [`Camera::generate_ray`] and [`Camera::generate_ray_differential`] alike, that reads as the
+//! pbrt chain: film point -> camera_from_raster (an affine map of raster x and y) -> lens ->
+//! clip -> world_from_camera(t). The pose enters through a small private cache (the pose's
+//! axes and eye in f32; for a perspective pinhole the world direction is then `R q` for the
+//! film point `q` on the camera plane z = 1, one normalisation, no 4x4 divide), computed once
+//! for a fixed pose and per ray for a moving one, with the same function, so a moving camera at
+//! a keyframe's time gives the fixed camera's rays bit for bit. Poses must be affine (every
+//! look-at is); the transforms of [`ProjectiveCamera`] stay the reference the rays are tested
+//! against, and `project` uses them.
 //!
 //! ```
 //! use obscura_camera::{
-//!     Camera, CameraBase, CameraSample, FilmGeometry, FovAxis, PerspectiveCamera, Shutter,
-//!     ThinLens, look_at_pose,
+//!     Camera, CameraBase, CameraSample, FilmGeometry, FovAxis, LookAt, PerspectiveCamera,
+//!     Shutter, ThinLens, look_at_pose,
 //! };
 //! use obscura_space::{Point2, Point3, Vector3};
 //!
 //! // A 2 x 2 image, fov 90 degrees, eye at the origin looking down world -z.
 //! let shutter = Shutter::new(0.0, 1.0)?;
-//! let eye = (Point3::new(0.0, 0.0, 0.0), Point3::new(0.0, 0.0, -1.0), Vector3::new(0.0, 1.0, 0.0));
+//! let eye = LookAt::new(Point3::new(0.0, 0.0, 0.0), Point3::new(0.0, 0.0, -1.0), Vector3::new(0.0, 1.0, 0.0));
 //! let base = CameraBase::new(look_at_pose(eye, None, shutter)?, shutter, FilmGeometry::new([2, 2], None, None)?);
 //! let camera = PerspectiveCamera::new(base, 90.0, FovAxis::Smaller, ThinLens::PINHOLE)?;
 //!
@@ -82,13 +85,13 @@ mod projective;
 pub use any::AnyCamera;
 pub use camera::{
     Camera, CameraBase, CameraRay, CameraRayDifferential, CameraSample, DEFAULT_FAR, DEFAULT_NEAR,
-    LookAt, ThinLens, look_at_pose,
+    LookAt, MAX_BLADES, ThinLens, look_at_pose,
 };
 pub use cube_face::{CubeFace, CubeFaceCamera};
 pub use cylindrical::CylindricalCamera;
 pub use environment::EnvironmentCamera;
 pub use error::CameraError;
-pub use film::{FilmGeometry, FovAxis, MAX_RESOLUTION, ScreenWindow, Shutter};
+pub use film::{FilmGeometry, FovAxis, MAX_RESOLUTION, ScreenWindow, Shutter, validate_clip};
 pub use fisheye::{FisheyeCamera, FisheyeProjection};
 pub use octahedral::OctahedralCamera;
 pub use ods::{OdsCamera, OdsEye};
@@ -97,5 +100,5 @@ pub use opencv::{
 };
 pub use opencv_fisheye::{FISHEYE_INVERSE_TOLERANCE_PX, OpenCvFisheyeCamera};
 pub use orthographic::OrthographicCamera;
-pub use perspective::PerspectiveCamera;
+pub use perspective::{PerspectiveCamera, validate_fov};
 pub use projective::ProjectiveCamera;

@@ -1,12 +1,16 @@
 //! The orthographic camera, pinhole or thin lens.
 
 use crate::camera::{
-    CameraBase, CameraRayModel, PoseFrame, ThinLens, fixed_map_of, is_unit_length,
+    Camera, CameraBase, CameraRay, CameraRayDifferential, CameraSample, PoseFrame, ThinLens,
+    differential_of, is_unit_length, ray_time,
 };
 use crate::error::CameraError;
+use crate::film::{FilmGeometry, Shutter};
 use crate::projective::{ProjectiveCamera, from_rows};
 use glam::{Vec2, Vec3, Vec3A};
-use obscura_space::{Camera as CameraSpace, Point2, Point3, Raster, Ray, Vector3, World};
+use obscura_space::{
+    AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, Ray, Vector3, World,
+};
 
 /// An orthographic camera: a parallel projection of the box between `near` and `far` whose
 /// cross-section is the screen window, in camera-space world units. Rays start on the plane
@@ -30,27 +34,26 @@ pub struct OrthographicCamera {
     /// Film to camera x and y in world units: `(x', y') = scale * p_raster + offset`,
     /// pose-independent (see `ProjectiveCamera::film_map`).
     film_from_raster: (Vec3A, Vec3A),
-    /// The fast path's constants of a fixed pose.
-    fixed: Option<OrthographicMap>,
+    /// The pose cache of a fixed pose, computed once; None when the pose moves.
+    fixed: Option<OrthographicCache>,
 }
 
-/// Per-pose constants of the fast path. The film point `(x', y')` (camera space, from
-/// [`OrthographicCamera`]'s pose-independent `film_from_raster`) has its ray start at world
+/// The per-pose cache of [`OrthographicCamera::ray`]. The film point `(x', y')` (camera
+/// space, from the pose-independent `film_from_raster`) has its ray start at world
 /// `eye + R (x', y', 0) = eye + x * x' + y * y'` and run along `R z`.
 ///
 /// Precision: the origin's camera z is 0 up to the rounding of that sum, at most about
-/// `3 * 2^-24 (|x'| + |y'| + |eye|)`, small against the origin's own size. (An earlier form
-/// folded the film offset into `o_1 = eye + R (offset, 0)`, whose rounding, up to
-/// `2^-24 |offset|` with `|offset|` the window's half-extent, reached camera z too.)
+/// `3 * 2^-24 (|x'| + |y'| + |eye|)`, small against the origin's own size; the film offset is
+/// kept out of the world constants so that its cancellation stays within the film plane.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct OrthographicMap {
+struct OrthographicCache {
     eye: Vec3A,
     /// World images of camera +x, +y and +z.
     x: Vec3A,
     y: Vec3A,
     axis: Vec3A,
-    /// The aperture's axes: `x` and `y` again (as in `PerspectiveMap`, separate copies keep
-    /// LLVM from loading them into registers before the lens test).
+    /// The aperture's axes: `x` and `y` again (as in the perspective cache, separate copies
+    /// keep LLVM from loading them into registers before the lens test).
     lens_x: Vec3A,
     lens_y: Vec3A,
     /// `axis` normalised, and the distances to camera z = near and far along it: exactly
@@ -80,13 +83,15 @@ impl OrthographicCamera {
         ]);
         let projective =
             ProjectiveCamera::build(base, lens, (screen_from_camera, camera_from_screen), false)?;
-        let mut camera = OrthographicCamera {
+        let fixed = projective
+            .base()
+            .fixed_frame()
+            .map(|f| Self::cache(projective.base(), &f));
+        Ok(OrthographicCamera {
             film_from_raster: projective.film_map(1.0),
             projective,
-            fixed: None,
-        };
-        camera.fixed = fixed_map_of(&camera);
-        Ok(camera)
+            fixed,
+        })
     }
 
     /// The projective chain (screen, NDC and raster transforms).
@@ -101,35 +106,12 @@ impl OrthographicCamera {
     }
 }
 
-impl CameraRayModel for OrthographicCamera {
-    type WorldMap = OrthographicMap;
-
+impl OrthographicCamera {
+    /// The pose cache of a camera frame: the fixed pose's at construction, the pose's at the
+    /// ray's time for a moving camera (the same function, so a moving camera at a keyframe's
+    /// time gives the fixed camera's rays bit for bit).
     #[inline]
-    fn base(&self) -> &CameraBase {
-        self.projective.base()
-    }
-
-    #[inline]
-    fn uses_lens(&self) -> bool {
-        self.projective.lens().is_thin_lens()
-    }
-
-    #[inline]
-    fn ray_camera(&self, p_film: Point2<Raster>, u_lens: glam::Vec2) -> Ray<CameraSpace> {
-        // The film point (x, y) in world units; its ray starts on z = 0 and runs along +z.
-        let p_camera = self.projective.film_point(p_film);
-        let p_origin = Point3::new(p_camera.x, p_camera.y, 0.0);
-        let d_camera = Vector3::new(0.0, 0.0, 1.0);
-        if self.projective.lens().is_thin_lens() {
-            self.projective.through_lens(p_origin, d_camera, u_lens)
-        } else {
-            self.projective.clipped(p_origin, d_camera)
-        }
-    }
-
-    #[inline]
-    fn world_map(&self, frame: &PoseFrame) -> OrthographicMap {
-        let base = self.projective.base();
+    fn cache(base: &CameraBase, frame: &PoseFrame) -> OrthographicCache {
         let axis = Vec3A::from(frame.z.as_vec3());
         let length = axis.length();
         let (t_min, t_max) = if is_unit_length(length) {
@@ -137,7 +119,7 @@ impl CameraRayModel for OrthographicCamera {
         } else {
             (base.near * length, base.far * length)
         };
-        OrthographicMap {
+        OrthographicCache {
             eye: frame.eye.as_vec3().into(),
             x: frame.x.as_vec3().into(),
             y: frame.y.as_vec3().into(),
@@ -150,39 +132,39 @@ impl CameraRayModel for OrthographicCamera {
         }
     }
 
-    #[inline]
-    fn fixed_map(&self) -> Option<&OrthographicMap> {
-        self.fixed.as_ref()
-    }
-
-    // Always: the per-ray body; left to LLVM it fell out of line once the aperture warp
-    // was inlined, costing a call and spills (perspective pinhole 84 -> 104 instructions).
+    /// The world ray of a film point and lens sample (time 0): where this model's rays are
+    /// built, for `generate_ray` and the differentials alike. `cache` is the pose at the
+    /// ray's time. Inlined always: it is the per-ray body.
     #[inline(always)]
-    fn ray_world(&self, map: &OrthographicMap, p_film: Point2<Raster>, u_lens: Vec2) -> Ray<World> {
+    fn ray(&self, cache: &OrthographicCache, p_film: Point2<Raster>, u_lens: Vec2) -> Ray<World> {
         let lens = self.projective.lens();
-        // The film point in camera space (see OrthographicMap on precision), then its world
-        // position eye + R (x', y', 0).
+        // Film point -> camera_from_raster: the affine plane map to camera (x', y') in world
+        // units (see OrthographicCache on precision).
         let (film_scale, film_offset) = self.film_from_raster;
         let q = film_scale * Vec3A::new(p_film.x, p_film.y, 0.0) + film_offset;
-        let p_center = map.x * q.x + map.y * q.y + map.eye;
+        // world_from_camera(t) of the film point, through the cache: eye + R (x', y', 0).
+        let p_center = cache.x * q.x + cache.y * q.y + cache.eye;
         if !lens.is_thin_lens() {
+            // Clip: along R z, [near, far] was scaled once in the cache.
             return Ray {
                 origin: Point3::from_glam(Vec3::from(p_center)),
-                direction: Vector3::from_glam(Vec3::from(map.direction)),
+                direction: Vector3::from_glam(Vec3::from(cache.direction)),
                 time: 0.0,
-                t_min: map.t_min,
-                t_max: map.t_max,
+                t_min: cache.t_min,
+                t_max: cache.t_max,
             };
         }
-        // Thin lens: from the lens point p_center + R (a.x, a.y, 0) to the focus point
-        // p_center + focal_distance R z: direction R (-a.x, -a.y, focal_distance), whose camera
-        // z is focal_distance, so camera z = near is at distance near * len / focal_distance.
+        // Lens: from the lens point p_center + R (a.x, a.y, 0) to the focus point
+        // p_center + focal_distance R z, along R (-a.x, -a.y, focal_distance).
         let base = self.projective.base();
         let a = lens.aperture_point(u_lens);
-        let offset = map.lens_x * a.x + map.lens_y * a.y;
-        let v = map.axis * lens.focal_distance - offset;
+        let offset = cache.lens_x * a.x + cache.lens_y * a.y;
+        let v = cache.axis * lens.focal_distance - offset;
+        // Clip: that direction has camera z focal_distance, so camera z = near is at distance
+        // near * len / focal_distance along the unit direction.
         let length = v.length();
         let per_z = length / lens.focal_distance;
+        // world_from_camera(t) of the origin: the lens point.
         Ray {
             origin: Point3::from_glam(Vec3::from(p_center + offset)),
             direction: Vector3::from_glam(Vec3::from(v / length)),
@@ -193,12 +175,64 @@ impl CameraRayModel for OrthographicCamera {
     }
 }
 
-impl OrthographicCamera {
-    /// The raster position of world point `p` at `time` (see [`Camera::project`](crate::Camera::project)).
-    fn project_world(&self, p: Point3<World>, time: f32) -> Option<Point2<Raster>> {
-        let camera_from_world = self.base().pose(time).inverse();
+impl Camera for OrthographicCamera {
+    #[inline]
+    fn generate_ray(&self, sample: &CameraSample) -> Option<CameraRay> {
+        let time = ray_time(self.shutter(), sample)?;
+        // The call in each arm (not through one merged cache reference) lets LLVM keep the
+        // fixed cache's fields where they are.
+        let mut ray = match &self.fixed {
+            Some(cache) => self.ray(cache, sample.p_film, sample.p_lens),
+            None => {
+                let base = self.projective.base();
+                let cache = Self::cache(base, &base.frame_at(time));
+                self.ray(&cache, sample.p_film, sample.p_lens)
+            }
+        };
+        ray.time = time;
+        Some(CameraRay { ray, weight: 1.0 })
+    }
+
+    #[inline]
+    fn generate_ray_differential(&self, sample: &CameraSample) -> Option<CameraRayDifferential> {
+        let time = ray_time(self.shutter(), sample)?;
+        // As in generate_ray: the call in each arm keeps the fixed cache read in place.
+        let rays = |cache: &_| {
+            differential_of(sample, time, |p_film| {
+                self.ray(cache, p_film, sample.p_lens)
+            })
+        };
+        Some(match &self.fixed {
+            Some(cache) => rays(cache),
+            None => rays(&{
+                let base = self.projective.base();
+                Self::cache(base, &base.frame_at(time))
+            }),
+        })
+    }
+
+    fn project(&self, p: Point3<World>, time: f32) -> Option<Point2<Raster>> {
+        let camera_from_world = self.projective.base().pose(time).inverse();
         self.projective.project_camera(camera_from_world.point(p))
     }
-}
 
-crate::camera::camera_via_model!(OrthographicCamera, project_world);
+    #[inline]
+    fn film(&self) -> &FilmGeometry {
+        &self.projective.base().film
+    }
+
+    #[inline]
+    fn shutter(&self) -> Shutter {
+        self.projective.base().shutter
+    }
+
+    #[inline]
+    fn world_from_camera(&self) -> &AnimatedTransform<World, CameraSpace> {
+        &self.projective.base().world_from_camera
+    }
+
+    #[inline]
+    fn uses_lens_sample(&self) -> bool {
+        self.projective.lens().is_thin_lens()
+    }
+}

@@ -1,11 +1,16 @@
 //! The perspective camera, pinhole or thin lens.
 
-use crate::camera::{CameraBase, CameraRayModel, PoseFrame, ThinLens, fixed_map_of};
+use crate::camera::{
+    Camera, CameraBase, CameraRay, CameraRayDifferential, CameraSample, PoseFrame, ThinLens,
+    differential_of, ray_time,
+};
 use crate::error::{CameraError, finite};
-use crate::film::FovAxis;
+use crate::film::{FilmGeometry, FovAxis, Shutter};
 use crate::projective::{ProjectiveCamera, from_rows};
 use glam::{Vec2, Vec3, Vec3A};
-use obscura_space::{Camera as CameraSpace, Point2, Point3, Raster, Ray, Vector3, World};
+use obscura_space::{
+    AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, Ray, Vector3, World,
+};
 
 /// A perspective camera: the projection plane at camera z = 1 scaled so that the field of view
 /// spans the screen window's half-extent along [`FovAxis`]; rays from the eye (or, with a thin
@@ -32,13 +37,13 @@ pub struct PerspectiveCamera {
     /// Film to the camera plane z = 1: `(x', y') = scale * p_raster + offset` (screen x and
     /// y over `s`), pose-independent (see `ProjectiveCamera::film_map`).
     plane_from_raster: (Vec3A, Vec3A),
-    /// The fast path's constants of a fixed pose.
-    fixed: Option<PerspectiveMap>,
+    /// The pose cache of a fixed pose, computed once; None when the pose moves.
+    fixed: Option<PerspectiveCache>,
 }
 
-/// Per-pose constants of the fast path: the pose's linear part `R` (its columns, the world
-/// images of camera +x, +y, +z) and the eye. With `q = (x', y', 1)` the film point on the camera
-/// plane z = 1 (from [`PerspectiveCamera`]'s pose-independent `plane_from_raster`), the world
+/// The per-pose cache of [`PerspectiveCamera::ray`]: the pose's linear part `R` (its columns,
+/// the world images of camera +x, +y, +z) and the eye. With `q = (x', y', 1)` the film point
+/// on the camera plane z = 1 (from the pose-independent `plane_from_raster`), the world
 /// direction through the lens centre is `R q = x * x' + y * y' + z`: a 2D affine map and a 3x3
 /// linear one instead of a 4x4 projective map with a divide and a pose transform.
 ///
@@ -48,27 +53,35 @@ pub struct PerspectiveCamera {
 ///
 /// Precision of that "exactly 1" (u = 2^-24). `q` is formed in camera space first, so its z is
 /// exactly 1, and the rounding of `x' = scale * p_raster + offset` (which cancels: `offset`
-/// reaches the window's half-extent over `s`, e.g. 74.7 on a 4 x 528 film, against `|q|` ~ 1
-/// at the centre rows) only moves the film point within the plane, by an f32 step of the raster
-/// position. Then `R q` rounds each world component by at most `3u sum_j |R_ij| |q_j|`, a
-/// vector of length at most `3 sqrt(3) u |q|`: camera z is `1 + d` with `|d| <= 5.2u |q|`,
-/// relative to the `|q|` the tests measure rays by. The rounding of `len` cancels (the
-/// direction is divided by it, `t` multiplied by it). An earlier form folded the film offset
-/// into the world constant `d_1 = R (offset, 1)`, so that `w = d_x x + d_y y + d_1` cancelled in
-/// all three world components, camera z included: errors of order `u |offset|`, measured at
-/// 60u at the centre rows of that tall film, where the tests allow `16.8u |q|` ~ 20u.
+/// reaches the window's half-extent over `s` against `|q|` ~ 1 at the centre rows) only moves
+/// the film point within the plane, by an f32 step of the raster position. Then `R q` rounds
+/// each world component by at most `3u sum_j |R_ij| |q_j|`, a vector of length at most
+/// `3 sqrt(3) u |q|`: camera z is `1 + d` with `|d| <= 5.2u |q|`, relative to the `|q|` the
+/// tests measure rays by. The rounding of `len` cancels (the direction is divided by it, `t`
+/// multiplied by it). Folding the film offset into a world constant would let it cancel in
+/// camera z too (see docs/performance.md).
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct PerspectiveMap {
+struct PerspectiveCache {
     /// World images of camera +x, +y and +z.
     x: Vec3A,
     y: Vec3A,
     z: Vec3A,
     eye: Vec3A,
-    /// The aperture's axes: `x` and `y` again. Separate copies measure 2 instructions fewer
-    /// per pinhole ray (callgrind): with shared ones LLVM loads them into registers before the
-    /// lens test.
+    /// The aperture's axes: `x` and `y` again, as separate copies so that LLVM does not load
+    /// them into registers before the lens test (see docs/performance.md).
     lens_x: Vec3A,
     lens_y: Vec3A,
+}
+
+/// Checks a perspective field of view: finite and in (0, 180) degrees. What
+/// [`PerspectiveCamera::new`] checks; public so that a scene layer can check its key before
+/// building a camera.
+pub fn validate_fov(fov_degrees: f32) -> Result<(), CameraError> {
+    finite("fov", fov_degrees)?;
+    if !(fov_degrees > 0.0 && fov_degrees < 180.0) {
+        return Err(CameraError::Fov { got: fov_degrees });
+    }
+    Ok(())
 }
 
 impl PerspectiveCamera {
@@ -82,10 +95,7 @@ impl PerspectiveCamera {
         fov_axis: FovAxis,
         lens: ThinLens,
     ) -> Result<PerspectiveCamera, CameraError> {
-        finite("fov", fov_degrees)?;
-        if !(fov_degrees > 0.0 && fov_degrees < 180.0) {
-            return Err(CameraError::Fov { got: fov_degrees });
-        }
+        validate_fov(fov_degrees)?;
         base.validate(true)?;
         // The fov spans the chosen half-extent h of the window: s = h / tan(fov / 2).
         let half_extent = f64::from(fov_axis.half_extent(base.film.screen_window()));
@@ -108,15 +118,13 @@ impl PerspectiveCamera {
         ]);
         let projective =
             ProjectiveCamera::build(base, lens, (screen_from_camera, camera_from_screen), true)?;
-        let mut camera = PerspectiveCamera {
+        Ok(PerspectiveCamera {
             plane_from_raster: projective.film_map(1.0 / scale),
+            fixed: projective.base().fixed_frame().map(|f| Self::cache(&f)),
             projective,
             fov_degrees,
             fov_axis,
-            fixed: None,
-        };
-        camera.fixed = fixed_map_of(&camera);
-        Ok(camera)
+        })
     }
 
     /// The projective chain (screen, NDC and raster transforms).
@@ -141,35 +149,13 @@ impl PerspectiveCamera {
     }
 }
 
-impl CameraRayModel for PerspectiveCamera {
-    type WorldMap = PerspectiveMap;
-
+impl PerspectiveCamera {
+    /// The pose cache of a camera frame: the fixed pose's at construction, the pose's at the
+    /// ray's time for a moving camera (the same function, so a moving camera at a keyframe's
+    /// time gives the fixed camera's rays bit for bit).
     #[inline]
-    fn base(&self) -> &CameraBase {
-        self.projective.base()
-    }
-
-    #[inline]
-    fn uses_lens(&self) -> bool {
-        self.projective.lens().is_thin_lens()
-    }
-
-    #[inline]
-    fn ray_camera(&self, p_film: Point2<Raster>, u_lens: glam::Vec2) -> Ray<CameraSpace> {
-        // The film point on the near plane gives the pinhole direction from the eye.
-        let p_camera = self.projective.film_point(p_film);
-        let d_camera = p_camera.to_vector().normalize();
-        if self.projective.lens().is_thin_lens() {
-            self.projective
-                .through_lens(Point3::ORIGIN, d_camera, u_lens)
-        } else {
-            self.projective.clipped(Point3::ORIGIN, d_camera)
-        }
-    }
-
-    #[inline]
-    fn world_map(&self, frame: &PoseFrame) -> PerspectiveMap {
-        PerspectiveMap {
+    fn cache(frame: &PoseFrame) -> PerspectiveCache {
+        PerspectiveCache {
             x: frame.x.as_vec3().into(),
             y: frame.y.as_vec3().into(),
             z: frame.z.as_vec3().into(),
@@ -179,43 +165,44 @@ impl CameraRayModel for PerspectiveCamera {
         }
     }
 
-    #[inline]
-    fn fixed_map(&self) -> Option<&PerspectiveMap> {
-        self.fixed.as_ref()
-    }
-
-    // Always: the per-ray body; left to LLVM it fell out of line once the aperture warp
-    // was inlined, costing a call and spills (perspective pinhole 84 -> 104 instructions).
+    /// The world ray of a film point and lens sample (time 0): where this model's rays are
+    /// built, for `generate_ray` and the differentials alike. `cache` is the pose at the
+    /// ray's time. Inlined always: it is the per-ray body, and out of line it costs a call and
+    /// spills.
     #[inline(always)]
-    fn ray_world(&self, map: &PerspectiveMap, p_film: Point2<Raster>, u_lens: Vec2) -> Ray<World> {
+    fn ray(&self, cache: &PerspectiveCache, p_film: Point2<Raster>, u_lens: Vec2) -> Ray<World> {
         let base = self.projective.base();
         let lens = self.projective.lens();
-        // The film point on the plane z = 1, in camera space so that its z stays exactly 1
-        // (see PerspectiveMap on precision), then the direction through the lens centre, R q.
+        // Film point -> camera_from_raster: the affine plane map onto the plane z = 1, in
+        // camera space so that its z stays exactly 1: q = (x', y', 1).
         let (plane_scale, plane_offset) = self.plane_from_raster;
         let q = plane_scale * Vec3A::new(p_film.x, p_film.y, 0.0) + plane_offset;
-        let w = map.x * q.x + map.y * q.y + map.z;
+        // world_from_camera(t) of the pinhole direction, through the cache: R q.
+        let w = cache.x * q.x + cache.y * q.y + cache.z;
         if !lens.is_thin_lens() {
+            // Clip: camera z along R q grows by 1 per unit of R q (see PerspectiveCache).
             let length = w.length();
             return Ray {
-                origin: Point3::from_glam(Vec3::from(map.eye)),
+                origin: Point3::from_glam(Vec3::from(cache.eye)),
                 direction: Vector3::from_glam(Vec3::from(w / length)),
                 time: 0.0,
                 t_min: base.near * length,
                 t_max: base.far * length,
             };
         }
-        // Thin lens: the centre ray reaches the plane of focus at eye + focal_distance * R q;
-        // the sample ray goes there from the lens point eye + R (a.x, a.y, 0). Its direction
-        // R (focal_distance q - a) has camera z focal_distance, so camera z = near is at
-        // distance near * len / focal_distance along the unit direction.
+        // Lens: the centre ray reaches the plane of focus at eye + focal_distance * R q; the
+        // sample ray goes there from the lens point eye + R (a.x, a.y, 0), along
+        // R (focal_distance q - a).
         let a = lens.aperture_point(u_lens);
-        let offset = map.lens_x * a.x + map.lens_y * a.y;
+        let offset = cache.lens_x * a.x + cache.lens_y * a.y;
         let v = w * lens.focal_distance - offset;
+        // Clip: that direction has camera z focal_distance, so camera z = near is at distance
+        // near * len / focal_distance along the unit direction.
         let length = v.length();
         let per_z = length / lens.focal_distance;
+        // world_from_camera(t) of the origin: the lens point.
         Ray {
-            origin: Point3::from_glam(Vec3::from(map.eye + offset)),
+            origin: Point3::from_glam(Vec3::from(cache.eye + offset)),
             direction: Vector3::from_glam(Vec3::from(v / length)),
             time: 0.0,
             t_min: base.near * per_z,
@@ -224,12 +211,61 @@ impl CameraRayModel for PerspectiveCamera {
     }
 }
 
-impl PerspectiveCamera {
-    /// The raster position of world point `p` at `time` (see [`Camera::project`](crate::Camera::project)).
-    fn project_world(&self, p: Point3<World>, time: f32) -> Option<Point2<Raster>> {
-        let camera_from_world = self.base().pose(time).inverse();
+impl Camera for PerspectiveCamera {
+    #[inline]
+    fn generate_ray(&self, sample: &CameraSample) -> Option<CameraRay> {
+        let time = ray_time(self.shutter(), sample)?;
+        // The call in each arm (not through one merged cache reference) lets LLVM keep the
+        // fixed cache's fields where they are.
+        let mut ray = match &self.fixed {
+            Some(cache) => self.ray(cache, sample.p_film, sample.p_lens),
+            None => self.ray(
+                &Self::cache(&self.projective.base().frame_at(time)),
+                sample.p_film,
+                sample.p_lens,
+            ),
+        };
+        ray.time = time;
+        Some(CameraRay { ray, weight: 1.0 })
+    }
+
+    #[inline]
+    fn generate_ray_differential(&self, sample: &CameraSample) -> Option<CameraRayDifferential> {
+        let time = ray_time(self.shutter(), sample)?;
+        // As in generate_ray: the call in each arm keeps the fixed cache read in place.
+        let rays = |cache: &_| {
+            differential_of(sample, time, |p_film| {
+                self.ray(cache, p_film, sample.p_lens)
+            })
+        };
+        Some(match &self.fixed {
+            Some(cache) => rays(cache),
+            None => rays(&Self::cache(&self.projective.base().frame_at(time))),
+        })
+    }
+
+    fn project(&self, p: Point3<World>, time: f32) -> Option<Point2<Raster>> {
+        let camera_from_world = self.projective.base().pose(time).inverse();
         self.projective.project_camera(camera_from_world.point(p))
     }
-}
 
-crate::camera::camera_via_model!(PerspectiveCamera, project_world);
+    #[inline]
+    fn film(&self) -> &FilmGeometry {
+        &self.projective.base().film
+    }
+
+    #[inline]
+    fn shutter(&self) -> Shutter {
+        self.projective.base().shutter
+    }
+
+    #[inline]
+    fn world_from_camera(&self) -> &AnimatedTransform<World, CameraSpace> {
+        &self.projective.base().world_from_camera
+    }
+
+    #[inline]
+    fn uses_lens_sample(&self) -> bool {
+        self.projective.lens().is_thin_lens()
+    }
+}

@@ -4,9 +4,7 @@
 use crate::camera::{CameraBase, ThinLens};
 use crate::error::CameraError;
 use glam::{DMat4, DVec2, DVec3, Vec3A};
-use obscura_space::{
-    Camera as CameraSpace, Ndc, Point2, Point3, Raster, Ray, Screen, Transform, Vector3,
-};
+use obscura_space::{Camera as CameraSpace, Ndc, Point2, Point3, Raster, Screen, Transform};
 
 /// The space chain of a projective camera, named the way the matrices compose:
 /// `camera_from_raster = camera_from_screen * screen_from_raster`, and so on.
@@ -178,32 +176,24 @@ impl ProjectiveCamera {
         self.camera_from_raster.inverse()
     }
 
-    /// The fast paths' film map: screen x and y of a raster position times `factor` (the
+    /// The models' film map (their camera_from_raster step): screen x and y of a raster position times `factor` (the
     /// perspective model's `1 / s`, giving the film point on the plane z = 1; 1 for the
     /// orthographic model) as `scale * p_raster + offset`, composed in f64 and rounded once,
     /// in the first two lanes of `(scale, offset)` (the third 0) so that it is one SIMD
     /// multiply and add per ray.
     ///
-    /// Why the models apply it per ray in camera space rather than fold it into their world
-    /// constants: `offset` reaches the window's half-extent (e.g. 323 on a 3 x 969 film)
-    /// while the film point near the window's centre is ~1, so the affine map cancels. In
-    /// camera space that cancellation only moves the film point within its plane, by an f32
-    /// step of the raster position; folded into world constants it cancelled in all three
-    /// world components, the view axis included, and the clip range (camera z) was off by
-    /// about `2^-24 * offset`.
+    /// Why the models apply it per ray in camera space rather than fold it into their pose
+    /// caches: `offset` reaches the window's half-extent while the film point near the
+    /// window's centre is ~1, so the affine map cancels. In camera space that cancellation
+    /// only moves the film point within its plane, by an f32 step of the raster position;
+    /// folded into world constants it would cancel in all three world components, the view
+    /// axis included, and put the clip range (camera z) off by about `2^-24 * offset`.
     pub(crate) fn film_map(&self, factor: f64) -> (Vec3A, Vec3A) {
         let (scale, offset) = self.screen_from_raster_xy;
         (
             (scale * factor).as_vec2().extend(0.0).into(),
             (offset * factor).as_vec2().extend(0.0).into(),
         )
-    }
-
-    /// The film point of a raster position in camera space, on the near plane (screen z = 0).
-    #[inline]
-    pub(crate) fn film_point(&self, p_film: Point2<Raster>) -> Point3<CameraSpace> {
-        self.camera_from_raster
-            .point(Point3::new(p_film.x, p_film.y, 0.0))
     }
 
     /// The raster position of a camera-space point, or None outside `[near, far]` in z.
@@ -215,38 +205,5 @@ impl ProjectiveCamera {
         }
         let p_raster = self.raster_from_camera().point(p_camera);
         Some(Point2::new(p_raster.x, p_raster.y))
-    }
-
-    /// A camera-space ray from `origin` (on the plane z = 0) along unit `direction`, clipped
-    /// so that the camera z of every point in `[t_min, t_max]` lies in `[near, far]`.
-    #[inline]
-    pub(crate) fn clipped(
-        &self,
-        origin: Point3<CameraSpace>,
-        direction: Vector3<CameraSpace>,
-    ) -> Ray<CameraSpace> {
-        // z(t) = t * d.z from z = 0, and d.z > 0 for every ray these models make.
-        let inv_dz = 1.0 / direction.z;
-        Ray::new(origin, direction, 0.0).with_range(self.base.near * inv_dz, self.base.far * inv_dz)
-    }
-
-    /// Cook et al.'s thin lens: the ray through the lens centre along `d_pinhole` (from
-    /// `p_center`, on z = 0) fixes the point on the plane of focus; the sample ray goes there
-    /// from the lens point, offset from `p_center` on the plane z = 0.
-    #[inline]
-    pub(crate) fn through_lens(
-        &self,
-        p_center: Point3<CameraSpace>,
-        d_pinhole: Vector3<CameraSpace>,
-        u_lens: glam::Vec2,
-    ) -> Ray<CameraSpace> {
-        // Sample the point on the lens.
-        let p_lens_2d = self.lens.aperture_point(u_lens);
-        let p_lens = Point3::new(p_center.x + p_lens_2d.x, p_center.y + p_lens_2d.y, 0.0);
-        // Compute the point on the plane of focus: where the centre ray reaches z = focal_distance.
-        let t_focus = self.lens.focal_distance / d_pinhole.z;
-        let p_focus = p_center + d_pinhole * t_focus;
-        // The sample ray: from the lens point through the point in focus.
-        self.clipped(p_lens, (p_focus - p_lens).normalize())
     }
 }

@@ -10,12 +10,12 @@ use crate::scene::{
 use glam::Vec3;
 use obscura_accel::{Placement, Scene, SceneBuilder, Shape, TriangleMesh};
 use obscura_camera::{
-    AnyCamera, CameraBase, EnvironmentCamera, FilmGeometry, FovAxis, OrthographicCamera,
-    PerspectiveCamera, ScreenWindow, Shutter, ThinLens, look_at_pose,
+    AnyCamera, CameraBase, EnvironmentCamera, FilmGeometry, OrthographicCamera, PerspectiveCamera,
+    look_at_pose,
 };
 use obscura_sample::Sampler;
 use obscura_shade::{EnvironmentLight, Light, Material, ShadingScene};
-use obscura_space::{AnimatedTransform, Point3, Vector3};
+use obscura_space::AnimatedTransform;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -108,13 +108,15 @@ impl RenderScene {
                 }
             };
             let placement = match s.transform_end {
-                Some(end) if end != s.transform && d.camera.shutter[0] < d.camera.shutter[1] => {
+                Some(end)
+                    if end != s.transform && d.camera.shutter.open < d.camera.shutter.close =>
+                {
                     Placement::Moving(
                         AnimatedTransform::new(
                             s.transform,
-                            d.camera.shutter[0],
+                            d.camera.shutter.open,
                             end,
-                            d.camera.shutter[1],
+                            d.camera.shutter.close,
                         )
                         .map_err(|e| {
                             RenderError::scene(
@@ -264,10 +266,6 @@ fn material(m: MaterialSettings) -> Material {
     }
 }
 
-fn point(v: [f32; 3]) -> Point3<obscura_space::World> {
-    Point3::new(v[0], v[1], v[2])
-}
-
 fn build_camera(
     file: &Path,
     c: &CameraSettings,
@@ -279,38 +277,18 @@ fn build_camera(
         let key = key.to_string();
         move |e: obscura_camera::CameraError| RenderError::scene(file, key, e.to_string())
     };
-    let shutter = Shutter::new(c.shutter[0], c.shutter[1]).map_err(err("camera.shutter"))?;
-    let look = |l: &crate::scene::LookAt| {
-        (
-            point(l.eye),
-            point(l.target),
-            Vector3::new(l.up[0], l.up[1], l.up[2]),
-        )
-    };
-    let pose =
-        look_at_pose(look(&c.start), c.end.as_ref().map(look), shutter).map_err(err("camera"))?;
-    let window = match c.screen_window {
-        Some(w) => {
-            Some(ScreenWindow::new(w[0], w[1], w[2], w[3]).map_err(err("camera.screen_window"))?)
-        }
-        None => None,
-    };
-    let film = FilmGeometry::new(resolution, window, crop).map_err(err("film.resolution"))?;
-    let base = CameraBase::new(pose, shutter, film).with_clip(c.near, c.far);
-    let lens = || -> Result<ThinLens, RenderError> {
-        ThinLens::new(c.lens_radius, c.focal_distance)
-            .and_then(|l| l.with_blades(c.aperture_blades, c.aperture_rotation))
-            .map_err(err("camera.lens_radius"))
-    };
+    // Every value was checked by the camera crate when the scene was parsed; what can still
+    // fail here is the film with the command line's resolution and crop.
+    let pose = look_at_pose(c.start, c.end, c.shutter).map_err(err("camera"))?;
+    let film =
+        FilmGeometry::new(resolution, c.screen_window, crop).map_err(err("film.resolution"))?;
+    let base = CameraBase::new(pose, c.shutter, film).with_clip(c.near, c.far);
     Ok(match c.kind {
-        CameraKind::Perspective => {
-            let axis: FovAxis = c.fov_axis.parse().map_err(err("camera.fov_axis"))?;
-            AnyCamera::Perspective(
-                PerspectiveCamera::new(base, c.fov, axis, lens()?).map_err(err("camera"))?,
-            )
-        }
+        CameraKind::Perspective => AnyCamera::Perspective(
+            PerspectiveCamera::new(base, c.fov, c.fov_axis, c.lens).map_err(err("camera"))?,
+        ),
         CameraKind::Orthographic => {
-            AnyCamera::Orthographic(OrthographicCamera::new(base, lens()?).map_err(err("camera"))?)
+            AnyCamera::Orthographic(OrthographicCamera::new(base, c.lens).map_err(err("camera"))?)
         }
         CameraKind::Environment => {
             AnyCamera::Environment(EnvironmentCamera::new(base).map_err(err("camera"))?)

@@ -71,4 +71,8 @@ pub use postprocess::{
 pub use render::{
     RenderOptions, RenderOutcome, RenderStats, TILE_SIZE, TILE_WINDOW, render, sample_value, tiles,
 };
-pub use scene::*;
+pub use scene::{
+    CameraKind, CameraSettings, FilmSettings, FilterSettings, IntegratorKind, IntegratorSettings,
+    LightSettings, MaterialSettings, SamplerSettings, SceneDescription, ShapeGeometry,
+    ShapeSettings, load_description, parse_description,
+};

@@ -14,11 +14,11 @@
 use crate::build::RenderScene;
 use crate::film::{Film, PixelRect, TileBuffer};
 use crate::scene::IntegratorKind;
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 use obscura_camera::{Camera, CameraSample};
 use obscura_sample::SampleStream;
 use obscura_shade::PathIntegrator;
-use obscura_space::{Point2, Ray, World};
+use obscura_space::{Ray, World};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
@@ -284,13 +284,8 @@ fn render_tile(
         for x in tile.x0..tile.x1 {
             stats.samples += 1;
             let mut stream = scene.sampler.stream([x, y], index);
-            let dims = stream.camera_with(uses_lens, uses_time);
-            let p_film = Vec2::new(x as f32, y as f32) + dims.film;
-            let sample = CameraSample {
-                p_film: Point2::from_glam(p_film),
-                p_lens: dims.lens,
-                time: dims.time,
-            };
+            let sample = CameraSample::from_stream(&mut stream, [x, y], uses_lens, uses_time);
+            let p_film = sample.p_film.to_glam();
             let Some(camera_ray) = scene.camera.generate_ray(&sample) else {
                 // No ray: the sample sees nothing, but still counts in the pixel's mean.
                 stats.no_ray += 1;

@@ -30,8 +30,8 @@ fn samplers(c: &mut Criterion) {
                     for x in 0..TILE {
                         for index in 0..SPP {
                             let mut stream = sampler.stream(black_box([x, y]), index);
-                            let dims = stream.camera();
-                            sum += dims.film.x + dims.lens.y + dims.time;
+                            let (film, lens, time) = stream.camera();
+                            sum += film.x + lens.y + time;
                             for _ in 0..3 {
                                 sum += stream.next_2d().x;
                             }

@@ -100,7 +100,7 @@ pub(crate) fn owen_scramble(v: u32, seed: u32) -> u32 {
 
 /// The body of `owen_scramble`, on the bit-reversed value and giving the bit-reversed result:
 /// `owen_scramble(v, s) == owen_hash(v.reverse_bits(), s).reverse_bits()`. Callers that hold a
-/// value already reversed save the two reversals (a dozen instructions each on x86-64).
+/// value already reversed save the two reversals.
 #[inline]
 pub(crate) fn owen_hash(mut x: u32, seed: u32) -> u32 {
     x = x.wrapping_add(seed);

@@ -5,15 +5,15 @@
 //! What is here: [`Sampler`], a small value naming one of four generators
 //! ([`SamplerKind`]: independent, stratified, Halton, Sobol), and [`SampleStream`], a
 //! cursor over the dimensions of one sample whose first call, [`SampleStream::camera`], gives
-//! the camera's [`CameraDims`]. Warps turn canonical numbers into shapes:
+//! the camera's film offset, lens sample and time as plain glam values. Warps turn canonical numbers into shapes:
 //! [`square_to_concentric_disk`] and [`square_to_polygon`] for the aperture,
 //! [`ShutterCurve`] and [`shutter_time`] for the shutter, [`square_to_cosine_hemisphere`] and
 //! [`square_to_uniform_sphere`] for shading, each with its pdf. [`sin_cos_pi`] (and [`sin_cos_pi_vec4`]) is the short
 //! sine and cosine the per-sample warps and cameras use instead of libm's. Errors are
 //! [`SampleError`].
 //!
-//! What is not here: cameras, films, filters, random number generators with state. A camera
-//! takes [`CameraDims`]; it never owns a sampler.
+//! What is not here: cameras, films, filters, random number generators with state. The camera
+//! crate draws its sample from a [`SampleStream`]; a camera never owns a sampler.
 //!
 //! The design decision: **every value is a pure function of (pixel, sample index, dimension,
 //! seed)**. There is no generator state to share or to advance in order, so the same seed
@@ -30,11 +30,11 @@
 //! let pixel = [10, 20];
 //! for index in 0..sampler.samples_per_pixel() {
 //!     let mut stream = sampler.stream(pixel, index);
-//!     let dims = stream.camera();
-//!     let p_raster = glam::Vec2::new(pixel[0] as f32, pixel[1] as f32) + dims.film;
-//!     let p_lens = 0.05 * square_to_concentric_disk(dims.lens); // lens radius 0.05
-//!     let time = shutter_time(ShutterCurve::Box.sample(dims.time), [0.0, 1.0]);
-//!     assert!(dims.film.cmpge(glam::Vec2::ZERO).all() && dims.film.cmplt(glam::Vec2::ONE).all());
+//!     let (film, lens, time) = stream.camera();
+//!     let p_raster = glam::Vec2::new(pixel[0] as f32, pixel[1] as f32) + film;
+//!     let p_lens = 0.05 * square_to_concentric_disk(lens); // lens radius 0.05
+//!     let time = shutter_time(ShutterCurve::Box.sample(time), [0.0, 1.0]);
+//!     assert!(film.cmpge(glam::Vec2::ZERO).all() && film.cmplt(glam::Vec2::ONE).all());
 //!     assert!(p_lens.length() <= 0.05 + 1e-6 && (0.0..1.0).contains(&time));
 //!     let _u_bsdf = stream.next_2d(); // dimensions 6-7, for shading
 //!     # let _ = p_raster;
@@ -56,7 +56,7 @@ mod warp;
 
 pub use error::SampleError;
 pub use hash::ONE_MINUS_EPSILON;
-pub use sampler::{CameraDims, MAX_SAMPLES_PER_PIXEL, SampleStream, Sampler, SamplerKind};
+pub use sampler::{MAX_SAMPLES_PER_PIXEL, SampleStream, Sampler, SamplerKind};
 pub use shutter::{ShutterCurve, shutter_time};
 pub use trig::{sin_cos_pi, sin_cos_pi_vec4};
 pub use warp::{

@@ -186,20 +186,6 @@ impl Sampler {
     }
 }
 
-/// The camera's share of one sample: where in the pixel, where on the lens, when.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct CameraDims {
-    /// Offset inside the pixel, in `[0, 1)^2` (dimensions 0 and 1): the raster position is
-    /// `pixel + film`.
-    pub film: glam::Vec2,
-    /// Lens sample in `[0, 1)^2` (dimensions 2 and 3), to be warped to the aperture, e.g. by
-    /// [`crate::square_to_concentric_disk`].
-    pub lens: glam::Vec2,
-    /// Normalised shutter time in `[0, 1)` (dimension 4), to be mapped by
-    /// [`crate::shutter_time`], optionally through a [`crate::ShutterCurve`].
-    pub time: f32,
-}
-
 /// A cursor over the dimensions of one sample, from [`Sampler::stream`].
 ///
 /// Layout: [`SampleStream::camera`] takes dimensions 0-4 (film 0-1, lens 2-3, time 4); then
@@ -221,10 +207,14 @@ pub struct SampleStream<'a> {
 }
 
 impl SampleStream<'_> {
-    /// The camera dimensions 0-4. Meant as the first call; called later it still returns
-    /// dimensions 0-4 and moves the cursor to at least 5.
+    /// The camera dimensions 0-4 as `(film, lens, time)`: the offset inside the pixel in
+    /// `[0, 1)^2` (dimensions 0-1; the raster position is `pixel + film`), the lens sample in
+    /// `[0, 1)^2` (dimensions 2-3, to be warped onto the aperture) and the normalised shutter
+    /// time in `[0, 1)` (dimension 4, to be mapped by [`crate::shutter_time`]). Meant as the
+    /// first call; called later it still returns dimensions 0-4 and moves the cursor to at
+    /// least 5.
     #[inline]
-    pub fn camera(&mut self) -> CameraDims {
+    pub fn camera(&mut self) -> (Vec2, Vec2, f32) {
         self.camera_with(true, true)
     }
 
@@ -235,12 +225,12 @@ impl SampleStream<'_> {
     /// invisible to a camera that ignores them (a pinhole's lens, an instantaneous shutter's
     /// time) and saves two of a pinhole sample's five draws.
     #[inline]
-    pub fn camera_with(&mut self, lens: bool, time: bool) -> CameraDims {
-        let dims = CameraDims {
-            film: self.pair(0),
-            lens: if lens { self.pair(2) } else { Vec2::splat(0.5) },
-            time: if time { self.one(4) } else { 0.0 },
-        };
+    pub fn camera_with(&mut self, lens: bool, time: bool) -> (Vec2, Vec2, f32) {
+        let dims = (
+            self.pair(0),
+            if lens { self.pair(2) } else { Vec2::splat(0.5) },
+            if time { self.one(4) } else { 0.0 },
+        );
         self.dimension = self.dimension.max(5);
         dims
     }
@@ -354,10 +344,10 @@ mod tests {
             for (pixel, index) in [([0, 0], 0), ([7, 2], 5), ([1000, 31], 15)] {
                 let v = |d| sampler.value(pixel, index, d);
                 let mut stream = sampler.stream(pixel, index);
-                let dims = stream.camera();
-                assert_eq!(dims.film, Vec2::new(v(0), v(1)), "{kind:?}");
-                assert_eq!(dims.lens, Vec2::new(v(2), v(3)), "{kind:?}");
-                assert_eq!(dims.time, v(4), "{kind:?}");
+                let (film, lens, time) = stream.camera();
+                assert_eq!(film, Vec2::new(v(0), v(1)), "{kind:?}");
+                assert_eq!(lens, Vec2::new(v(2), v(3)), "{kind:?}");
+                assert_eq!(time, v(4), "{kind:?}");
                 for first in [6, 8, 10] {
                     assert_eq!(
                         stream.next_2d(),
@@ -373,11 +363,11 @@ mod tests {
     fn stream_layout_matches_value() {
         let sampler = Sampler::new(SamplerKind::Stratified, 16, 7).unwrap();
         let mut stream = sampler.stream([3, 4], 5);
-        let dims = stream.camera();
+        let (film, lens, time) = stream.camera();
         let v = |d| sampler.value([3, 4], 5, d);
-        assert_eq!(dims.film, Vec2::new(v(0), v(1)));
-        assert_eq!(dims.lens, Vec2::new(v(2), v(3)));
-        assert_eq!(dims.time, v(4));
+        assert_eq!(film, Vec2::new(v(0), v(1)));
+        assert_eq!(lens, Vec2::new(v(2), v(3)));
+        assert_eq!(time, v(4));
         // After the camera, next_2d skips dimension 5 and reads the pair (6, 7).
         assert_eq!(stream.next_2d(), Vec2::new(v(6), v(7)));
         assert_eq!(stream.next_1d(), v(8));

@@ -290,8 +290,8 @@ pub(crate) fn sobol_key(pixel_key: u64) -> u64 {
 /// Both coordinates of pair `pair` (dimensions `2 pair` and `2 pair + 1`) of the sample whose
 /// index reversed is `index_reversed` (see [`sobol_prepare_reversed`]): the same values as two
 /// [`sobol`] calls, with the pair's key, index shuffle and raw coordinates computed once, and
-/// the two scrambled coordinates reversed together in one 64-bit reversal (the sampler is a
-/// sixth of a path-traced render's instructions, mostly hashing and bit reversal).
+/// the two scrambled coordinates reversed together in one 64-bit reversal (hashing and bit
+/// reversal are most of the sampler's cost; see docs/performance.md).
 #[inline]
 pub(crate) fn sobol_pair_reversed(key: u64, index_reversed: u32, pair: u32) -> [f32; 2] {
     let prepared = sobol_prepare_reversed(key, index_reversed, pair);

@@ -380,10 +380,10 @@ fn differential_at_the_rim_reflects_the_inner_neighbour() {
 fn moving_pose_is_evaluated_at_the_ray_time() {
     let shutter = obscura_camera::Shutter::new(0.0, 1.0).unwrap();
     let start = identity_look();
-    let end = (
+    let end = obscura_camera::LookAt::new(
         obscura_space::Point3::new(2.0, 0.0, 0.0),
         obscura_space::Point3::new(2.0, 0.0, -1.0),
-        start.2,
+        start.up,
     );
     let base = obscura_camera::CameraBase::new(
         obscura_camera::look_at_pose(start, Some(end), shutter).unwrap(),

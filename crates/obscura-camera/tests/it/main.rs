@@ -23,10 +23,10 @@ mod thin_lens;
 mod validation;
 
 use obscura_camera::{
-    AnyCamera, CameraBase, EnvironmentCamera, FilmGeometry, FovAxis, OrthographicCamera,
+    AnyCamera, CameraBase, EnvironmentCamera, FilmGeometry, FovAxis, LookAt, OrthographicCamera,
     PerspectiveCamera, ScreenWindow, Shutter, ThinLens, look_at_pose,
 };
-use obscura_space::{Point3, Vector3, World};
+use obscura_space::{Point3, Vector3};
 use proptest::prelude::*;
 
 /// A proptest config of `cases` cases, unless `PROPTEST_CASES` is set (for stress runs such as
@@ -58,8 +58,8 @@ pub fn assert_close2(a: glam::Vec2, b: glam::Vec2, tol: f32) {
 }
 
 /// The scene format's look-at example: eye at the origin looking down world -z, y up.
-pub fn identity_look() -> (Point3<World>, Point3<World>, Vector3<World>) {
-    (
+pub fn identity_look() -> LookAt {
+    LookAt::new(
         Point3::new(0.0, 0.0, 0.0),
         Point3::new(0.0, 0.0, -1.0),
         Vector3::new(0.0, 1.0, 0.0),
@@ -68,7 +68,7 @@ pub fn identity_look() -> (Point3<World>, Point3<World>, Vector3<World>) {
 
 /// A fixed camera base at `look` with the given film and clip range.
 pub fn base_at(
-    look: (Point3<World>, Point3<World>, Vector3<World>),
+    look: LookAt,
     resolution: [u32; 2],
     window: Option<ScreenWindow>,
     near: f32,
@@ -84,7 +84,7 @@ pub fn base_at(
 }
 
 /// A random look-at: eye within 10 of the origin, target at unit-ish distance, up not parallel.
-pub fn look_strategy() -> impl Strategy<Value = (Point3<World>, Point3<World>, Vector3<World>)> {
+pub fn look_strategy() -> impl Strategy<Value = LookAt> {
     let v = || (-1f32..1.0, -1f32..1.0, -1f32..1.0);
     ((-10f32..10.0, -10f32..10.0, -10f32..10.0), v(), v()).prop_filter_map(
         "degenerate look-at",
@@ -98,7 +98,7 @@ pub fn look_strategy() -> impl Strategy<Value = (Point3<World>, Point3<World>, V
             {
                 return None;
             }
-            Some((
+            Some(LookAt::new(
                 Point3::from_glam(eye),
                 Point3::from_glam(eye + dir),
                 Vector3::from_glam(up),

@@ -3,8 +3,8 @@
 
 use crate::{assert_close2, assert_close3, look_strategy};
 use obscura_camera::{
-    AnyCamera, Camera, CameraBase, CameraSample, FilmGeometry, FovAxis, PerspectiveCamera, Shutter,
-    ThinLens, look_at_pose,
+    AnyCamera, Camera, CameraBase, CameraSample, FilmGeometry, FovAxis, LookAt, PerspectiveCamera,
+    Shutter, ThinLens, look_at_pose,
 };
 use obscura_space::{Point2, Point3};
 use proptest::prelude::*;
@@ -59,8 +59,8 @@ proptest! {
 fn halfway_through_the_shutter() {
     let shutter = Shutter::new(2.0, 4.0).unwrap();
     let up = obscura_space::Vector3::new(0.0, 1.0, 0.0);
-    let start = (Point3::new(0.0, 0.0, 0.0), Point3::new(0.0, 0.0, -1.0), up);
-    let end = (Point3::new(2.0, 0.0, 0.0), Point3::new(2.0, 0.0, -1.0), up);
+    let start = LookAt::new(Point3::new(0.0, 0.0, 0.0), Point3::new(0.0, 0.0, -1.0), up);
+    let end = LookAt::new(Point3::new(2.0, 0.0, 0.0), Point3::new(2.0, 0.0, -1.0), up);
     let base = CameraBase::new(
         look_at_pose(start, Some(end), shutter).unwrap(),
         shutter,

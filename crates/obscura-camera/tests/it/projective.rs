@@ -180,13 +180,13 @@ fn check_clip_range(camera: &AnyCamera, p_film: Point2<Raster>) -> Result<(), Te
 #[test]
 fn clip_range_on_a_tall_film() {
     // Camera z along (0.29, 0.52, -0.81), camera x in world xy.
-    let perspective_look = (
+    let perspective_look = obscura_camera::LookAt::new(
         Point3::new(0.0, 0.0, 8.132996),
         Point3::new(0.2917941, 0.51542217, 8.132996 - 0.8057272),
         Vector3::new(0.0, 0.0, -1.0),
     );
     // Camera z along (-0.65, -0.12, -0.75), y along (-0.55, 0.75, 0.36), eye 3.6 from 0.
-    let orthographic_look = (
+    let orthographic_look = obscura_camera::LookAt::new(
         Point3::new(-3.4135153, 1.1702431, 0.0),
         Point3::new(-3.4135153 - 0.6539908, 1.1702431 - 0.12455316, -0.74617857),
         Vector3::new(-0.5524943, 0.75241345, 0.35864165),

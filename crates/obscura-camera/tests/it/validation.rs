@@ -119,6 +119,29 @@ fn other_models_and_base_reject_bad_parameters() {
     ));
 }
 
+/// Every model builds its rays from an affine pose: a projective one (bottom row not
+/// `[0 0 0 1]`) is refused at construction, while the look-at poses are accepted.
+#[test]
+fn projective_poses_are_refused() {
+    let mut m = glam::Mat4::IDENTITY;
+    m.x_axis.w = 0.5;
+    let projective = obscura_space::Transform::from_matrix(m).unwrap();
+    let mut b = base_at(identity_look(), [8, 8], None, 0.01, 1.0);
+    b.world_from_camera = obscura_space::AnimatedTransform::fixed(projective);
+    assert!(matches!(
+        PerspectiveCamera::new(b.clone(), 60.0, FovAxis::Smaller, ThinLens::PINHOLE),
+        Err(CameraError::ProjectivePose)
+    ));
+    assert!(matches!(
+        OrthographicCamera::new(b.clone(), ThinLens::PINHOLE),
+        Err(CameraError::ProjectivePose)
+    ));
+    assert!(matches!(
+        EnvironmentCamera::new(b),
+        Err(CameraError::ProjectivePose)
+    ));
+}
+
 #[test]
 fn extreme_valid_cameras_give_finite_rays() {
     for fov in [1e-3, 0.5, 179.9] {

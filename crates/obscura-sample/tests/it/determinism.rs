@@ -175,10 +175,10 @@ proptest! {
         let s = sampler(kind, 16, seed);
         let v = |d| s.value(pixel, index, d);
         let mut stream = s.stream(pixel, index);
-        let dims = stream.camera();
-        prop_assert_eq!(dims.film, Vec2::new(v(0), v(1)));
-        prop_assert_eq!(dims.lens, Vec2::new(v(2), v(3)));
-        prop_assert_eq!(dims.time, v(4));
+        let (film, lens, time) = stream.camera();
+        prop_assert_eq!(film, Vec2::new(v(0), v(1)));
+        prop_assert_eq!(lens, Vec2::new(v(2), v(3)));
+        prop_assert_eq!(time, v(4));
         prop_assert_eq!(stream.next_1d(), v(5));
         prop_assert_eq!(stream.next_2d(), Vec2::new(v(6), v(7)));
         prop_assert_eq!(stream.next_1d(), v(8));
@@ -195,11 +195,11 @@ proptest! {
         let s = sampler(kind, 16, seed);
         let v = |d| s.value(pixel, index, d);
         let mut stream = s.stream(pixel, index);
-        let dims = stream.camera_with(lens, time);
-        prop_assert_eq!(dims.film, Vec2::new(v(0), v(1)));
+        let (film, lens_dims, time_dims) = stream.camera_with(lens, time);
+        prop_assert_eq!(film, Vec2::new(v(0), v(1)));
         let lens_value = if lens { Vec2::new(v(2), v(3)) } else { Vec2::splat(0.5) };
-        prop_assert_eq!(dims.lens, lens_value);
-        prop_assert_eq!(dims.time, if time { v(4) } else { 0.0 });
+        prop_assert_eq!(lens_dims, lens_value);
+        prop_assert_eq!(time_dims, if time { v(4) } else { 0.0 });
         prop_assert_eq!(stream.next_1d(), v(5));
         prop_assert_eq!(stream.next_2d(), Vec2::new(v(6), v(7)));
     }

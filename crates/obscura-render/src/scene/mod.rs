@@ -1,0 +1,22 @@
+//! The scene file: parsing (serde + toml) and validation into a [`SceneDescription`].
+//!
+//! Parsing is strict: unknown keys are errors, every number is checked for NaN and range, and
+//! every error names the file, the key and the line. Nothing here builds cameras or BVHs; see
+//! [`crate::build`] for that.
+//!
+//! - `raw`: the serde structs, as TOML gives them;
+//! - `settings`: the public, validated settings types;
+//! - `parse`: the validating parser (film, sampler, integrator, materials, shapes, lights);
+//! - `camera`: the `[camera]` keys, mapped onto the camera crate's types and checks.
+
+mod camera;
+mod parse;
+mod raw;
+mod settings;
+
+pub use parse::{load_description, parse_description};
+pub use settings::{
+    CameraKind, CameraSettings, FilmSettings, FilterSettings, IntegratorKind, IntegratorSettings,
+    LightSettings, MaterialSettings, SamplerSettings, SceneDescription, ShapeGeometry,
+    ShapeSettings,
+};

@@ -1,0 +1,288 @@
+//! The public settings types of a validated scene file.
+
+use obscura_camera::{FovAxis, LookAt, ScreenWindow, Shutter, ThinLens};
+use obscura_sample::SamplerKind;
+use obscura_space::{Object, Transform, World};
+use std::path::PathBuf;
+
+/// Three numbers of the scene file: a point, vector or colour.
+pub(crate) type V3 = [f32; 3];
+
+/// A validated scene file: every value checked, paths resolved against the file's folder.
+#[derive(Clone, Debug)]
+pub struct SceneDescription {
+    /// The scene file itself.
+    pub file: PathBuf,
+    /// `[film]`.
+    pub film: FilmSettings,
+    /// `[sampler]`.
+    pub sampler: SamplerSettings,
+    /// `[integrator]`.
+    pub integrator: IntegratorSettings,
+    /// `[camera]`.
+    pub camera: CameraSettings,
+    /// `[materials.NAME]`, in name order; shapes refer to them by index.
+    pub materials: Vec<(String, MaterialSettings)>,
+    /// `[[shapes]]`, in file order.
+    pub shapes: Vec<ShapeSettings>,
+    /// `[[lights]]`, in file order.
+    pub lights: Vec<LightSettings>,
+    /// Keys that were given but that the chosen model ignores (e.g. `fov` on an orthographic
+    /// camera): worth a note to the user, not an error.
+    pub ignored: Vec<String>,
+}
+
+/// `[film]`: the image's size and reconstruction filter.
+#[derive(Clone, Debug)]
+pub struct FilmSettings {
+    /// Width and height in pixels, each >= 1.
+    pub resolution: [u32; 2],
+    /// The reconstruction filter.
+    pub filter: FilterSettings,
+    /// Optional crop window in NDC: x0, x1, y0, y1 (an extension of the format).
+    pub crop: Option<[f32; 4]>,
+}
+
+/// A reconstruction filter and its radius in pixels.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FilterSettings {
+    /// Constant over [-r, r]^2; default radius 0.5 (each sample counts for its own pixel only).
+    Box {
+        /// Radius in pixels.
+        radius: f32,
+    },
+    /// A tent falling linearly to zero at the radius; default radius 1.
+    Triangle {
+        /// Radius in pixels.
+        radius: f32,
+    },
+    /// A Gaussian with standard deviation radius / 3, shifted to zero at the radius; default 1.5.
+    Gaussian {
+        /// Radius in pixels.
+        radius: f32,
+    },
+    /// Mitchell-Netravali with B = C = 1/3; default radius 2.
+    Mitchell {
+        /// Radius in pixels.
+        radius: f32,
+    },
+}
+
+impl FilterSettings {
+    /// The filter's radius in pixels.
+    pub fn radius(&self) -> f32 {
+        match *self {
+            FilterSettings::Box { radius }
+            | FilterSettings::Triangle { radius }
+            | FilterSettings::Gaussian { radius }
+            | FilterSettings::Mitchell { radius } => radius,
+        }
+    }
+    /// The filter's name in the scene format.
+    pub fn name(&self) -> &'static str {
+        match self {
+            FilterSettings::Box { .. } => "box",
+            FilterSettings::Triangle { .. } => "triangle",
+            FilterSettings::Gaussian { .. } => "gaussian",
+            FilterSettings::Mitchell { .. } => "mitchell",
+        }
+    }
+}
+
+/// `[sampler]`.
+#[derive(Clone, Copy, Debug)]
+pub struct SamplerSettings {
+    /// Which sampler.
+    pub kind: SamplerKind,
+    /// Samples per pixel, >= 1.
+    pub spp: u32,
+    /// The seed every sample value derives from.
+    pub seed: u64,
+}
+
+/// What the integrator computes per pixel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IntegratorKind {
+    /// Path-traced radiance.
+    Path,
+    /// Camera-space z of the first hit.
+    Depth,
+    /// Distance from the ray's origin to the first hit.
+    Distance,
+    /// World-space position of the first hit.
+    Position,
+    /// World-space shading normal of the first hit, facing the viewer.
+    Normal,
+    /// The material's reflectance at the first hit.
+    Albedo,
+}
+
+impl IntegratorKind {
+    /// Every integrator, in the order the scene format lists them.
+    pub const ALL: [IntegratorKind; 6] = [
+        IntegratorKind::Path,
+        IntegratorKind::Depth,
+        IntegratorKind::Distance,
+        IntegratorKind::Position,
+        IntegratorKind::Normal,
+        IntegratorKind::Albedo,
+    ];
+    /// The scene-format name.
+    pub fn name(self) -> &'static str {
+        match self {
+            IntegratorKind::Path => "path",
+            IntegratorKind::Depth => "depth",
+            IntegratorKind::Distance => "distance",
+            IntegratorKind::Position => "position",
+            IntegratorKind::Normal => "normal",
+            IntegratorKind::Albedo => "albedo",
+        }
+    }
+    /// Parses a scene-format name.
+    pub fn parse(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|k| k.name() == name)
+    }
+}
+
+/// `[integrator]`.
+#[derive(Clone, Copy, Debug)]
+pub struct IntegratorSettings {
+    /// Which integrator.
+    pub kind: IntegratorKind,
+    /// Longest path (path integrator only), >= 1.
+    pub max_depth: u32,
+}
+
+/// Which camera model.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CameraKind {
+    /// Perspective projection (with an optional thin lens).
+    Perspective,
+    /// Orthographic projection (with an optional thin lens).
+    Orthographic,
+    /// Equirectangular 360 x 180 degree environment camera.
+    Environment,
+}
+
+/// `[camera]`, validated: the camera crate's own types, each checked by the camera crate.
+#[derive(Clone, Debug)]
+pub struct CameraSettings {
+    /// The model.
+    pub kind: CameraKind,
+    /// The pose at shutter open.
+    pub start: LookAt,
+    /// The pose at shutter close, when the camera moves.
+    pub end: Option<LookAt>,
+    /// Full field of view in degrees along `fov_axis` (perspective; checked only there).
+    pub fov: f32,
+    /// The axis `fov` spans.
+    pub fov_axis: FovAxis,
+    /// Optional screen window.
+    pub screen_window: Option<ScreenWindow>,
+    /// Near clip.
+    pub near: f32,
+    /// Far clip.
+    pub far: f32,
+    /// The lens: radius (0 for a pinhole), focal distance, aperture blades and rotation.
+    pub lens: ThinLens,
+    /// Shutter open and close times.
+    pub shutter: Shutter,
+}
+
+/// A material, validated.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum MaterialSettings {
+    /// Lambertian.
+    Diffuse {
+        /// Albedo per channel in [0, 1].
+        reflectance: V3,
+    },
+    /// Perfect specular reflector.
+    Mirror {
+        /// Reflectance per channel in [0, 1].
+        reflectance: V3,
+    },
+    /// Smooth glass.
+    Dielectric {
+        /// Index of refraction, > 0.
+        ior: f32,
+    },
+    /// GGX rough conductor (an extension).
+    RoughConductor {
+        /// Reflectance at normal incidence per channel.
+        reflectance: V3,
+        /// Roughness in (0, 1].
+        roughness: f32,
+    },
+}
+
+/// The geometry of a shape, in its object space.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ShapeGeometry {
+    /// An analytic sphere.
+    Sphere {
+        /// Centre.
+        center: V3,
+        /// Radius, > 0.
+        radius: f32,
+    },
+    /// The parallelogram origin + s edge_u + t edge_v.
+    Quad {
+        /// A corner.
+        origin: V3,
+        /// First edge.
+        edge_u: V3,
+        /// Second edge.
+        edge_v: V3,
+    },
+    /// A Wavefront OBJ mesh.
+    Mesh {
+        /// The file, resolved against the scene file's folder.
+        file: PathBuf,
+    },
+}
+
+/// A `[[shapes]]` entry, validated.
+#[derive(Clone, Debug)]
+pub struct ShapeSettings {
+    /// Its position in the file (for messages: `shapes[i]`).
+    pub index: usize,
+    /// Object-space geometry.
+    pub geometry: ShapeGeometry,
+    /// Index into [`SceneDescription::materials`], or `None` for the default grey diffuse.
+    pub material: Option<usize>,
+    /// Emitted radiance, when the shape is an area light.
+    pub emission: Option<V3>,
+    /// World from object at shutter open.
+    pub transform: Transform<World, Object>,
+    /// World from object at shutter close, when the shape moves.
+    pub transform_end: Option<Transform<World, Object>>,
+}
+
+/// A `[[lights]]` entry, validated.
+#[derive(Clone, Debug)]
+pub enum LightSettings {
+    /// A point light.
+    Point {
+        /// Position.
+        position: V3,
+        /// Radiant intensity per channel (W/sr).
+        intensity: V3,
+    },
+    /// A light at infinity.
+    Distant {
+        /// The way the light travels.
+        direction: V3,
+        /// Irradiance on a surface facing it.
+        irradiance: V3,
+    },
+    /// Light from every direction: constant or an equirectangular map.
+    Environment {
+        /// Constant radiance (or a scale on the map; default 1).
+        radiance: V3,
+        /// The map, resolved against the scene file's folder.
+        file: Option<PathBuf>,
+        /// World from light.
+        transform: Transform<World, World>,
+    },
+}
