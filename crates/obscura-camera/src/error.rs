@@ -152,6 +152,12 @@ pub enum CameraError {
         /// The value given.
         got: f32,
     },
+    /// A stereo convergence distance that is not positive.
+    #[error("convergence must be > 0, got {got}")]
+    Convergence {
+        /// The value given.
+        got: f32,
+    },
     /// A focal length (`fx` or `fy`, in pixels) that is not positive.
     #[error("{what} must be > 0 pixels, got {got}")]
     FocalLength {

@@ -102,6 +102,32 @@ impl ScreenWindow {
         [self.x_min, self.x_max, self.y_min, self.y_max]
     }
 
+    /// The window moved by a lens shift `[sx, sy]`, in fractions of its own width and height
+    /// (+x right, +y up), as an architectural camera's rising front moves the lens: `sy = 0.1`
+    /// shows a tenth of an image more at the top and as much less at the bottom, with vertical
+    /// lines kept parallel. Errors: a non-finite shift.
+    pub fn lens_shifted(self, shift: [f32; 2]) -> Result<ScreenWindow, CameraError> {
+        if !shift.iter().all(|v| v.is_finite()) {
+            let got = if shift[0].is_finite() {
+                shift[1]
+            } else {
+                shift[0]
+            };
+            return Err(CameraError::NonFinite {
+                what: "lens_shift",
+                got,
+            });
+        }
+        let dx = shift[0] * (self.x_max - self.x_min);
+        let dy = shift[1] * (self.y_max - self.y_min);
+        ScreenWindow::new(
+            self.x_min + dx,
+            self.x_max + dx,
+            self.y_min + dy,
+            self.y_max + dy,
+        )
+    }
+
     /// Half the width and half the height.
     pub fn half_extent(self) -> [f32; 2] {
         [

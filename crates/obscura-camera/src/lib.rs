@@ -81,6 +81,7 @@ mod opencv_fisheye;
 mod orthographic;
 mod perspective;
 mod projective;
+mod stereo;
 
 pub use any::AnyCamera;
 pub use camera::{
@@ -102,3 +103,4 @@ pub use opencv_fisheye::{FISHEYE_INVERSE_TOLERANCE_PX, OpenCvFisheyeCamera};
 pub use orthographic::OrthographicCamera;
 pub use perspective::{PerspectiveCamera, validate_fov};
 pub use projective::ProjectiveCamera;
+pub use stereo::{StereoEye, StereoRig};

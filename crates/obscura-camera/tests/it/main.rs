@@ -19,6 +19,7 @@ mod opencv;
 mod projective;
 mod ray_checks;
 mod sample_use;
+mod stereo;
 mod thin_lens;
 mod validation;
 
