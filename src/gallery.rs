@@ -5,9 +5,11 @@
 //! rendered once or several times with parameters varied, the panels laid side by side into one
 //! opaque PNG of the same name. [`generate`] does it all; [`FIGURES`] names what it makes.
 
+use obscura_camera::{CubeFace, FisheyeProjection, OpenCvIntrinsics};
 use obscura_render::{
     DepthOfField, Image, ImageInfo, RenderError, RenderOptions, RenderScene, SceneDescription,
-    depth_of_field, motion_blur, parse_description, render, screen_buffers, write_image,
+    compose_stereo, depth_of_field, motion_blur, parse_description, render, screen_buffers,
+    write_image,
 };
 use std::path::{Path, PathBuf};
 
@@ -56,7 +58,7 @@ macro_rules! figure {
 }
 
 /// Every figure the gallery makes, in order.
-pub const FIGURES: [Figure; 11] = [
+pub const FIGURES: [Figure; 20] = [
     figure!("projection-perspective"),
     figure!("projection-orthographic"),
     figure!("dof-lens-radius"),
@@ -68,6 +70,24 @@ pub const FIGURES: [Figure; 11] = [
     figure!("panorama"),
     figure!("postprocess-dof"),
     figure!("postprocess-motion"),
+    figure!("fisheye-projections"),
+    figure!("opencv-distortion"),
+    figure!("opencv-fisheye"),
+    figure!("panorama-octahedral"),
+    figure!("panorama-cylindrical"),
+    figure!("cube-map"),
+    figure!("stereo-anaglyph"),
+    figure!("ods"),
+    figure!("lens-shift"),
+];
+
+/// The `fisheye-projections` row: each projection and its field of view in degrees (the
+/// orthographic fisheye cannot reach 90 degrees off its axis).
+pub const FISHEYE_PANELS: [(FisheyeProjection, f32); 4] = [
+    (FisheyeProjection::Equidistant, 185.0),
+    (FisheyeProjection::Equisolid, 185.0),
+    (FisheyeProjection::Stereographic, 185.0),
+    (FisheyeProjection::Orthographic, 178.0),
 ];
 
 /// The lens radii of the `dof-lens-radius` row.
@@ -122,8 +142,20 @@ fn make_figure(out_dir: &Path, figure: Figure, quality: Quality) -> Result<Made,
         })?;
     }
     let mut base = parse_description(&scene_path, figure.scene)?;
-    base.film.resolution = quality.resolution(base.film.resolution);
+    let full = base.film.resolution;
+    base.film.resolution = quality.resolution(full);
     base.sampler.spp = quality.spp(base.sampler.spp);
+    // OpenCV intrinsics are in pixels: a smaller film scales them, about pixel edges (OpenCV's
+    // pixel centres are integers, so the image's edge is at -0.5).
+    if let Some(k) = &mut base.camera.intrinsics {
+        let scale = f64::from(base.film.resolution[0]) / f64::from(full[0]);
+        *k = OpenCvIntrinsics {
+            fx: k.fx * scale,
+            fy: k.fy * scale,
+            cx: (k.cx + 0.5) * scale - 0.5,
+            cy: (k.cy + 0.5) * scale - 0.5,
+        };
+    }
 
     let mut hot_cells = Vec::new();
     let panels: Vec<Image> = match figure.name {
@@ -154,6 +186,50 @@ fn make_figure(out_dir: &Path, figure: Figure, quality: Quality) -> Result<Made,
                 shoot(d)
             })
             .collect::<Result<_, _>>()?,
+        "fisheye-projections" => FISHEYE_PANELS
+            .iter()
+            .map(|&(projection, fov)| {
+                let mut d = base.clone();
+                d.camera.projection = projection;
+                d.camera.fov = fov;
+                shoot(d)
+            })
+            .collect::<Result<_, _>>()?,
+        "opencv-distortion" => {
+            let mut undistorted = base.clone();
+            undistorted.camera.distortion = vec![0.0; 4];
+            vec![shoot(base)?, shoot(undistorted)?]
+        }
+        "cube-map" => CubeFace::ALL
+            .iter()
+            .map(|&face| {
+                let mut d = base.clone();
+                d.camera.face = face;
+                shoot(d)
+            })
+            .collect::<Result<_, _>>()?,
+        "stereo-anaglyph" => {
+            let layout = base.camera.stereo.map(|s| s.layout);
+            match (base.stereo_eyes(), layout) {
+                (Some([left, right]), Some(layout)) => {
+                    let (left, right) = (shoot(left)?, shoot(right)?);
+                    vec![compose_stereo(&left, &right, layout).unwrap_or(left)]
+                }
+                _ => vec![shoot(base)?],
+            }
+        }
+        "lens-shift" => {
+            // The tilted camera aims at the shifted window's centre, so both frame the pillar.
+            let mut tilted = base.clone();
+            let shift = tilted.camera.lens_shift[1];
+            tilted.camera.lens_shift = [0.0, 0.0];
+            let look = &mut tilted.camera.start;
+            let depth = (look.target - look.eye).length();
+            let half_height = (0.5 * tilted.camera.fov).to_radians().tan() * full[1] as f32
+                / full[0].min(full[1]) as f32;
+            look.target.y += depth * 2.0 * half_height * shift;
+            vec![shoot(tilted)?, shoot(base)?]
+        }
         "postprocess-dof" | "postprocess-motion" => {
             let (distributed, post) = compare(base, figure.name == "postprocess-dof")?;
             let diff = difference(&distributed, &post);

@@ -1,9 +1,11 @@
 //! The `obscura` command: render a scene file, or check it.
 
 use clap::{Parser, Subcommand};
+use obscura_camera::CubeFace;
 use obscura_render::{
-    Checkpoint, Film, ImageInfo, IntegratorKind, OutputFormat, RenderError, RenderOptions,
-    RenderScene, load_description, render, scene_fingerprint, write_image,
+    CameraKind, Checkpoint, Film, ImageInfo, IntegratorKind, OutputFormat, RenderError,
+    RenderOptions, RenderScene, SceneDescription, StereoLayout, compose_stereo, load_description,
+    render, scene_fingerprint, write_image,
 };
 use signal_hook::consts::{SIGINT, SIGTERM};
 use std::io::IsTerminal;
@@ -90,6 +92,10 @@ struct RenderArgs {
     /// Continue a render from a checkpoint made with the same scene and flags
     #[arg(long, value_name = "FILE")]
     resume: Option<PathBuf>,
+    /// Render the six 90-degree faces of a cube map from the scene's camera position, to
+    /// OUT-px, OUT-nx, OUT-py, OUT-ny, OUT-pz, OUT-nz (OpenGL order; the film must be square)
+    #[arg(long)]
+    cube_map: bool,
 }
 
 /// SIGINT and SIGTERM handling: the first sets `cancel` (the render stops at the next pass
@@ -210,6 +216,19 @@ fn run_render(args: RenderArgs) -> Result<ExitCode, RenderError> {
     }
     for note in &description.ignored {
         eprintln!("note: {note}");
+    }
+    if let Some(views) = plan_views(&description, args.cube_map, &output) {
+        if args.checkpoint.is_some() || args.resume.is_some() {
+            return Err(setting(
+                if args.checkpoint.is_some() {
+                    "--checkpoint"
+                } else {
+                    "--resume"
+                },
+                "checkpoints hold one image; a cube map or a stereo pair renders several",
+            ));
+        }
+        return render_views(views, &output, threads);
     }
     // The checkpoint's fingerprint: the scene file's bytes and the settings after overrides.
     let fingerprint = if args.checkpoint.is_some() || args.resume.is_some() {
@@ -372,6 +391,113 @@ fn run_render(args: RenderArgs) -> Result<ExitCode, RenderError> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// A render of several views of one scene: a cube map's faces or a stereo pair's eyes.
+enum Views {
+    /// Each view to its own file.
+    Files(Vec<(SceneDescription, PathBuf)>),
+    /// The two eyes, composed into the one output.
+    Pair(Box<[SceneDescription; 2]>, StereoLayout),
+}
+
+/// The views `obscura render` makes of a scene: None for the usual single image.
+fn plan_views(d: &SceneDescription, cube_map: bool, output: &Path) -> Option<Views> {
+    if cube_map {
+        const SUFFIXES: [&str; 6] = ["px", "nx", "py", "ny", "pz", "nz"];
+        let faces = CubeFace::ALL
+            .into_iter()
+            .zip(SUFFIXES)
+            .map(|(face, suffix)| {
+                let mut view = d.clone();
+                view.camera.kind = CameraKind::CubeFace;
+                view.camera.face = face;
+                view.camera.stereo = None;
+                (view, suffixed(output, suffix))
+            })
+            .collect();
+        return Some(Views::Files(faces));
+    }
+    let [left, right] = d.stereo_eyes()?;
+    let layout = d.camera.stereo?.layout;
+    Some(match layout {
+        StereoLayout::Separate => Views::Files(vec![
+            (left, suffixed(output, "left")),
+            (right, suffixed(output, "right")),
+        ]),
+        layout => Views::Pair(Box::new([left, right]), layout),
+    })
+}
+
+/// `dir/name.ext` -> `dir/name-suffix.ext`.
+fn suffixed(output: &Path, suffix: &str) -> PathBuf {
+    let stem = output
+        .file_stem()
+        .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+    let ext = output
+        .extension()
+        .map_or_else(String::new, |e| format!(".{}", e.to_string_lossy()));
+    output.with_file_name(format!("{stem}-{suffix}{ext}"))
+}
+
+/// Renders several views one after the other. Each file is written whole when its view is
+/// done; an interrupt stops at once and writes nothing more (a pair is written only whole).
+fn render_views(
+    views: Views,
+    output: &Path,
+    threads: Option<usize>,
+) -> Result<ExitCode, RenderError> {
+    let interrupts = Interrupts::install()?;
+    let shoot = |d: SceneDescription| -> Result<Option<obscura_render::Image>, RenderError> {
+        let scene = RenderScene::build(d)?;
+        report_skipped(&scene);
+        let outcome = render(
+            &scene,
+            RenderOptions {
+                threads,
+                cancel: Some(&interrupts.cancel),
+                ..Default::default()
+            },
+        )
+        .map_err(|e| setting("--threads", format!("cannot start the worker threads: {e}")))?;
+        Ok(outcome.is_complete(&scene).then(|| outcome.film.resolve()))
+    };
+    let info = |d: &SceneDescription| ImageInfo {
+        partial: false,
+        samples_per_pixel: d.sampler.spp,
+    };
+    let interrupted = || {
+        let signal = interrupts.received().unwrap_or(SIGINT);
+        eprintln!("interrupted: the view in progress was not written");
+        Ok(ExitCode::from(128 + signal as u8))
+    };
+    match views {
+        Views::Files(files) => {
+            for (d, path) in files {
+                let spp = info(&d);
+                let Some(image) = shoot(d)? else {
+                    return interrupted();
+                };
+                write_image(&path, &image, &spp)?;
+                println!("wrote {}", path.display());
+            }
+        }
+        Views::Pair(eyes, layout) => {
+            let [left, right] = *eyes;
+            let spp = info(&left);
+            let Some(l) = shoot(left)? else {
+                return interrupted();
+            };
+            let Some(r) = shoot(right)? else {
+                return interrupted();
+            };
+            if let Some(image) = compose_stereo(&l, &r, layout) {
+                write_image(output, &image, &spp)?;
+                println!("wrote {}", output.display());
+            }
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
 fn parse_resolution(r: &str) -> Result<[u32; 2], RenderError> {
     let bad = || {
         setting(
@@ -404,20 +530,19 @@ fn run_check(scene_path: &Path) -> Result<(), RenderError> {
     let scene = RenderScene::build(description)?;
     report_skipped(&scene);
     let d = &scene.description;
-    let kind = match d.camera.kind {
-        obscura_render::CameraKind::Perspective => "perspective",
-        obscura_render::CameraKind::Orthographic => "orthographic",
-        obscura_render::CameraKind::Environment => "environment",
+    let kind = d.camera.kind.name();
+    let lens = if d.camera.lens.radius > 0.0
+        && matches!(
+            d.camera.kind,
+            CameraKind::Perspective | CameraKind::Orthographic
+        ) {
+        format!(
+            " with a thin lens (radius {}, focused at {})",
+            d.camera.lens.radius, d.camera.lens.focal_distance
+        )
+    } else {
+        String::new()
     };
-    let lens =
-        if d.camera.lens.radius > 0.0 && d.camera.kind != obscura_render::CameraKind::Environment {
-            format!(
-                " with a thin lens (radius {}, focused at {})",
-                d.camera.lens.radius, d.camera.lens.focal_distance
-            )
-        } else {
-            String::new()
-        };
     let moving = d
         .shapes
         .iter()

@@ -7,11 +7,14 @@ use crate::scene::{
     CameraKind, CameraSettings, IntegratorKind, LightSettings, MaterialSettings, SceneDescription,
     ShapeGeometry,
 };
+use crate::scene::{DEFAULT_INTERAXIAL, camera_key};
 use glam::Vec3;
 use obscura_accel::{Placement, Scene, SceneBuilder, Shape, TriangleMesh};
 use obscura_camera::{
-    AnyCamera, CameraBase, EnvironmentCamera, FilmGeometry, OrthographicCamera, PerspectiveCamera,
-    look_at_pose,
+    AnyCamera, CameraBase, CameraError, CubeFaceCamera, CylindricalCamera, EnvironmentCamera,
+    FilmGeometry, FisheyeCamera, LookAt, OctahedralCamera, OdsCamera, OpenCvCamera,
+    OpenCvFisheyeCamera, OrthographicCamera, PerspectiveCamera, ScreenWindow, look_at_pose,
+    opencv_pose,
 };
 use obscura_sample::Sampler;
 use obscura_shade::{EnvironmentLight, Light, Material, ShadingScene};
@@ -53,9 +56,9 @@ impl RenderScene {
     /// Builds everything the description names: loads meshes and maps, makes the camera.
     pub fn build(description: SceneDescription) -> Result<RenderScene, RenderError> {
         let d = &description;
-        let file = d.file.clone();
-        check_memory(&file, d.film.resolution)?;
-        let camera = build_camera(&file, &d.camera, d.film.resolution, d.film.crop)?;
+        check_memory(d)?;
+        let camera = build_camera(&d.camera, d.film.resolution, d.film.crop)
+            .map_err(|e| d.error(camera_key(&e), e.to_string()))?;
         let [x0, x1, y0, y1] = obscura_camera::Camera::film(&camera).pixel_bounds();
         let pixel_bounds = PixelRect { x0, y0, x1, y1 };
 
@@ -90,13 +93,10 @@ impl RenderScene {
                     let mesh = match meshes.get(mesh_file) {
                         Some(m) => m.clone(),
                         None => {
-                            let m = Arc::new(obscura_accel::load_obj(mesh_file).map_err(|e| {
-                                RenderError::scene(
-                                    file.clone(),
-                                    format!("{key}.file"),
-                                    e.to_string(),
-                                )
-                            })?);
+                            let m = Arc::new(
+                                obscura_accel::load_obj(mesh_file)
+                                    .map_err(|e| d.error(format!("{key}.file"), e.to_string()))?,
+                            );
                             if m.skipped_degenerate() > 0 {
                                 skipped_triangles.push((mesh_file.clone(), m.skipped_degenerate()));
                             }
@@ -118,20 +118,14 @@ impl RenderScene {
                             end,
                             d.camera.shutter.close,
                         )
-                        .map_err(|e| {
-                            RenderError::scene(
-                                file.clone(),
-                                format!("{key}.transform_end"),
-                                e.to_string(),
-                            )
-                        })?,
+                        .map_err(|e| d.error(format!("{key}.transform_end"), e.to_string()))?,
                     )
                 }
                 _ => Placement::Static(s.transform),
             };
             let instance = builder
                 .add(shape.clone(), placement.clone())
-                .map_err(|e| RenderError::scene(file.clone(), key.clone(), e.to_string()))?;
+                .map_err(|e| d.error(key.clone(), e.to_string()))?;
             instance_material.push(s.material.map_or(default_index, |m| m as u32));
             if let Some(e) = s.emission {
                 emitters.push((instance, shape, placement, Vec3::from(e)));
@@ -139,7 +133,7 @@ impl RenderScene {
         }
         let geometry = builder
             .build()
-            .map_err(|e| RenderError::scene(file.clone(), "shapes", e.to_string()))?;
+            .map_err(|e| d.error("shapes", e.to_string()))?;
 
         let mut lights = Vec::new();
         for (i, l) in d.lights.iter().enumerate() {
@@ -163,22 +157,21 @@ impl RenderScene {
                     file: Some(map),
                     transform,
                 } => {
-                    let (w, h, texels) = read_environment_map(map).map_err(|message| {
-                        RenderError::scene(file.clone(), format!("{key}.file"), message)
-                    })?;
+                    let (w, h, texels) = read_environment_map(map)
+                        .map_err(|message| d.error(format!("{key}.file"), message))?;
                     let scale = Vec3::from(*radiance);
                     let texels = texels.into_iter().map(|t| t * scale).collect();
                     EnvironmentLight::from_texels(w, h, texels, transform.matrix())
                         .map(Light::Environment)
                 }
             }
-            .map_err(|e| RenderError::scene(file.clone(), key, e.to_string()))?;
+            .map_err(|e| d.error(key, e.to_string()))?;
             lights.push(light);
         }
         let shading = ShadingScene::new(materials, instance_material, lights, emitters)
-            .map_err(|e| RenderError::scene(file.clone(), "lights", e.to_string()))?;
+            .map_err(|e| d.error("lights", e.to_string()))?;
         let sampler = Sampler::new(d.sampler.kind, d.sampler.spp, d.sampler.seed)
-            .map_err(|e| RenderError::scene(file.clone(), "sampler", e.to_string()))?;
+            .map_err(|e| d.error("sampler", e.to_string()))?;
         let filter = Filter::new(d.film.filter);
         Ok(RenderScene {
             description,
@@ -199,13 +192,13 @@ impl RenderScene {
 }
 
 /// Refuses, up front, a film that would not fit in memory, saying how much it needs.
-fn check_memory(file: &Path, resolution: [u32; 2]) -> Result<(), RenderError> {
+fn check_memory(d: &SceneDescription) -> Result<(), RenderError> {
+    let resolution = d.film.resolution;
     let pixels = u64::from(resolution[0]) * u64::from(resolution[1]);
     let need = pixels.saturating_mul(BYTES_PER_PIXEL);
     let available = available_memory();
     if need > available {
-        return Err(RenderError::scene(
-            file,
+        return Err(d.error(
             "film.resolution",
             format!(
                 "a {}x{} film needs {} of memory, more than the {} available",
@@ -266,32 +259,62 @@ fn material(m: MaterialSettings) -> Material {
     }
 }
 
-fn build_camera(
-    file: &Path,
+pub(crate) fn build_camera(
     c: &CameraSettings,
     resolution: [u32; 2],
     crop: Option<[f32; 4]>,
-) -> Result<AnyCamera, RenderError> {
-    let err = |key: &str| {
-        let file = file.to_path_buf();
-        let key = key.to_string();
-        move |e: obscura_camera::CameraError| RenderError::scene(file, key, e.to_string())
-    };
-    // Every value was checked by the camera crate when the scene was parsed; what can still
-    // fail here is the film with the command line's resolution and crop.
-    let pose = look_at_pose(c.start, c.end, c.shutter).map_err(err("camera"))?;
-    let film =
-        FilmGeometry::new(resolution, c.screen_window, crop).map_err(err("film.resolution"))?;
-    let base = CameraBase::new(pose, c.shutter, film).with_clip(c.near, c.far);
-    Ok(match c.kind {
-        CameraKind::Perspective => AnyCamera::Perspective(
-            PerspectiveCamera::new(base, c.fov, c.fov_axis, c.lens).map_err(err("camera"))?,
-        ),
-        CameraKind::Orthographic => {
-            AnyCamera::Orthographic(OrthographicCamera::new(base, c.lens).map_err(err("camera"))?)
+) -> Result<AnyCamera, CameraError> {
+    // The pose: OpenCV extrinsics, or the look-at(s), moved to one eye for a stereo pair.
+    let rig = c.stereo.map(|s| s.rig);
+    let eye = c.eye.zip(rig);
+    let pose = match c.extrinsics {
+        Some(x) => opencv_pose(x.rvec, x.tvec)?,
+        None => {
+            let for_eye = |look: LookAt| match eye {
+                Some((eye, rig)) => rig.eye_look_at(eye, look),
+                None => Ok(look),
+            };
+            let end = c.end.map(for_eye).transpose()?;
+            look_at_pose(for_eye(c.start)?, end, c.shutter)?
         }
-        CameraKind::Environment => {
-            AnyCamera::Environment(EnvironmentCamera::new(base).map_err(err("camera"))?)
+    };
+    // The screen window, lens-shifted and, for one eye of a pair, shifted off axis.
+    let projective = matches!(c.kind, CameraKind::Perspective | CameraKind::Orthographic);
+    let mut window = c.screen_window;
+    if projective && (c.lens_shift != [0.0, 0.0] || eye.is_some()) {
+        let mut w = window
+            .unwrap_or_else(|| ScreenWindow::default_for(resolution))
+            .lens_shifted(c.lens_shift)?;
+        if let Some((eye, rig)) = eye {
+            w = rig.eye_window(eye, w, c.fov, c.fov_axis)?;
+        }
+        window = Some(w);
+    }
+    let film = FilmGeometry::new(resolution, window, crop)?;
+    let base = CameraBase::new(pose, c.shutter, film).with_clip(c.near, c.far);
+    // The OpenCV models always have intrinsics from a parsed file; a description built in code
+    // without them gets the error a missing fx would.
+    let intrinsics = || {
+        c.intrinsics.ok_or(CameraError::NonFinite {
+            what: "fx",
+            got: f32::NAN,
+        })
+    };
+    Ok(match c.kind {
+        CameraKind::Perspective => PerspectiveCamera::new(base, c.fov, c.fov_axis, c.lens)?.into(),
+        CameraKind::Orthographic => OrthographicCamera::new(base, c.lens)?.into(),
+        CameraKind::Environment => EnvironmentCamera::new(base)?.into(),
+        CameraKind::OpenCv => OpenCvCamera::new(base, intrinsics()?, &c.distortion)?.into(),
+        CameraKind::OpenCvFisheye => {
+            OpenCvFisheyeCamera::new(base, intrinsics()?, &c.distortion)?.into()
+        }
+        CameraKind::Fisheye => FisheyeCamera::new(base, c.projection, c.fov, c.lens_shift)?.into(),
+        CameraKind::Cylindrical => CylindricalCamera::new(base, c.fov)?.into(),
+        CameraKind::Octahedral => OctahedralCamera::new(base)?.into(),
+        CameraKind::CubeFace => CubeFaceCamera::new(base, c.face)?.into(),
+        CameraKind::Ods => {
+            let interaxial = rig.map_or(DEFAULT_INTERAXIAL, |r| r.interaxial);
+            OdsCamera::new(base, interaxial)?.into()
         }
     })
 }

@@ -57,26 +57,6 @@ pub enum RenderError {
     },
 }
 
-impl RenderError {
-    /// A scene error about `key`; its line is looked up in the file (if it can be read).
-    pub fn scene(
-        file: impl Into<PathBuf>,
-        key: impl Into<String>,
-        message: impl Into<String>,
-    ) -> Self {
-        let (file, key) = (file.into(), key.into());
-        let line = std::fs::read_to_string(&file)
-            .ok()
-            .and_then(|source| crate::locate::line_of_key(&source, &key));
-        RenderError::Scene {
-            file,
-            line,
-            key: Some(key),
-            message: message.into(),
-        }
-    }
-}
-
 /// `file[:line][: key]: message`, the one-line form of a scene error.
 fn located(
     file: &std::path::Path,

@@ -58,6 +58,7 @@ mod output;
 mod postprocess;
 mod render;
 mod scene;
+mod stereo;
 
 pub use build::{BYTES_PER_PIXEL, DEFAULT_MATERIAL, RenderScene, human_bytes};
 pub use checkpoint::{CHECKPOINT_MAGIC, CHECKPOINT_VERSION, Checkpoint, scene_fingerprint};
@@ -72,7 +73,9 @@ pub use render::{
     RenderOptions, RenderOutcome, RenderStats, TILE_SIZE, TILE_WINDOW, render, sample_value, tiles,
 };
 pub use scene::{
-    CameraKind, CameraSettings, FilmSettings, FilterSettings, IntegratorKind, IntegratorSettings,
-    LightSettings, MaterialSettings, SamplerSettings, SceneDescription, ShapeGeometry,
-    ShapeSettings, load_description, parse_description,
+    CameraKind, CameraSettings, DEFAULT_INTERAXIAL, Extrinsics, FilmSettings, FilterSettings,
+    IntegratorKind, IntegratorSettings, LightSettings, MaterialSettings, SamplerSettings,
+    SceneDescription, ShapeGeometry, ShapeSettings, StereoLayout, StereoSettings, load_description,
+    parse_description,
 };
+pub use stereo::compose_stereo;

@@ -1,19 +1,25 @@
 //! The `[camera]` keys: each maps onto a camera-crate type or check (`LookAt`, `FovAxis`,
-//! `ScreenWindow`, `ThinLens`, `Shutter`, `validate_fov`, `validate_clip`), and a
-//! [`CameraError`] maps back onto the key at fault and its line. The camera crate holds the
-//! only set of checks.
+//! `ScreenWindow`, `ThinLens`, `Shutter`, `StereoRig`, `validate_fov`, `validate_clip`, the
+//! models' constructors), and a [`CameraError`] maps back onto the key at fault and its line.
+//! The camera crate holds the only set of checks: what needs the film (a model's valid field of
+//! view, a square film) is checked by building the camera once at parse time.
 
 use super::parse::Cx;
 use super::raw::RawCamera;
-use super::settings::{CameraKind, CameraSettings, V3};
+use super::settings::{CameraKind, CameraSettings, Extrinsics, StereoLayout, StereoSettings, V3};
 use crate::error::RenderError;
 use obscura_camera::{
-    CameraError, FovAxis, LookAt, ScreenWindow, Shutter, ThinLens, validate_clip, validate_fov,
+    CameraError, CubeFace, FisheyeProjection, FovAxis, LookAt, OpenCvIntrinsics, ScreenWindow,
+    Shutter, StereoRig, ThinLens, opencv_pose, validate_clip, validate_fov,
 };
 use obscura_space::{Point3, SpaceError, Vector3};
 
+/// The interaxial distance when `[camera.stereo]` does not give one: 65 mm, a typical adult's
+/// distance between the pupils, in metres.
+pub const DEFAULT_INTERAXIAL: f32 = 0.065;
+
 /// The scene key a camera-crate error is about.
-fn key_of(e: &CameraError) -> &'static str {
+pub(crate) fn camera_key(e: &CameraError) -> &'static str {
     match e {
         CameraError::NonFinite { what, .. } => match *what {
             "near" => "camera.near",
@@ -22,9 +28,19 @@ fn key_of(e: &CameraError) -> &'static str {
             "lens_radius" => "camera.lens_radius",
             "focal_distance" => "camera.focal_distance",
             "aperture rotation" => "camera.aperture_rotation",
+            "lens_shift" => "camera.lens_shift",
+            "fx" => "camera.fx",
+            "fy" => "camera.fy",
+            "cx" => "camera.cx",
+            "cy" => "camera.cy",
+            "distortion" => "camera.distortion",
+            "rvec" => "camera.rvec",
+            "tvec" => "camera.tvec",
+            "interaxial" => "camera.stereo.interaxial",
+            "convergence" => "camera.stereo.convergence",
             _ => "camera",
         },
-        CameraError::Fov { .. } => "camera.fov",
+        CameraError::Fov { .. } | CameraError::FisheyeFov { .. } => "camera.fov",
         CameraError::UnknownFovAxis(_) => "camera.fov_axis",
         CameraError::Near { .. } => "camera.near",
         CameraError::NearFar { .. } => "camera.far",
@@ -33,16 +49,15 @@ fn key_of(e: &CameraError) -> &'static str {
         CameraError::Blades { .. } => "camera.aperture_blades",
         CameraError::ScreenWindow { .. } => "camera.screen_window",
         CameraError::Shutter { .. } => "camera.shutter",
-        CameraError::Resolution { .. } | CameraError::ResolutionTooLarge { .. } => {
-            "film.resolution"
-        }
+        CameraError::Resolution { .. }
+        | CameraError::ResolutionTooLarge { .. }
+        | CameraError::FilmShape { .. } => "film.resolution",
         CameraError::CropWindow { .. } => "film.crop",
         CameraError::ProjectivePose | CameraError::Pose(_) => "camera",
         CameraError::UnknownFisheyeProjection(_) => "camera.projection",
-        CameraError::FisheyeFov { .. } => "camera.fov",
         CameraError::UnknownCubeFace(_) => "camera.face",
-        CameraError::FilmShape { .. } => "film.resolution",
         CameraError::Interaxial { .. } => "camera.stereo.interaxial",
+        CameraError::Convergence { .. } => "camera.stereo.convergence",
         CameraError::FocalLength { what, .. } => match *what {
             "fy" => "camera.fy",
             _ => "camera.fx",
@@ -51,18 +66,28 @@ fn key_of(e: &CameraError) -> &'static str {
     }
 }
 
-fn kind_name(kind: CameraKind) -> &'static str {
-    match kind {
-        CameraKind::Perspective => "perspective",
-        CameraKind::Orthographic => "orthographic",
-        CameraKind::Environment => "environment",
+/// Whether a model reads a `[camera]` key (the look-at, clip range and shutter every model
+/// reads); keys a model does not read are noted as ignored, so one scene can switch `type`.
+fn reads(kind: CameraKind, key: &str) -> bool {
+    use CameraKind::*;
+    match key {
+        "fov" => matches!(kind, Perspective | Fisheye | Cylindrical),
+        "fov_axis" => kind == Perspective,
+        "screen_window" | "lens_radius" | "focal_distance" | "aperture_blades"
+        | "aperture_rotation" => matches!(kind, Perspective | Orthographic),
+        "lens_shift" => matches!(kind, Perspective | Orthographic | Fisheye),
+        "fx" | "fy" | "cx" | "cy" | "distortion" => matches!(kind, OpenCv | OpenCvFisheye),
+        "projection" => kind == Fisheye,
+        "face" => kind == CubeFace,
+        "stereo" => matches!(kind, Perspective | Ods),
+        _ => true,
     }
 }
 
 impl Cx<'_> {
     /// A camera-crate error as a scene error at its key and line.
-    fn camera_err(&self, e: CameraError) -> RenderError {
-        self.err(key_of(&e), e.to_string())
+    pub(super) fn camera_err(&self, e: CameraError) -> RenderError {
+        self.err(camera_key(&e), e.to_string())
     }
 
     pub(super) fn camera(
@@ -70,15 +95,69 @@ impl Cx<'_> {
         c: RawCamera,
         ignored: &mut Vec<String>,
     ) -> Result<CameraSettings, RenderError> {
-        let kind = match c.kind.as_deref().unwrap_or("perspective") {
-            "perspective" => CameraKind::Perspective,
-            "orthographic" => CameraKind::Orthographic,
-            "environment" => CameraKind::Environment,
-            other => {
-                return Err(self.err(
-                    "camera.type",
-                    format!("unknown camera `{other}`, expected perspective, orthographic or environment"),
-                ));
+        let name = c.kind.as_deref().unwrap_or("perspective");
+        let Some(kind) = CameraKind::from_name(name) else {
+            let names: Vec<&str> = CameraKind::ALL.iter().map(|k| k.name()).collect();
+            return Err(self.err(
+                "camera.type",
+                format!(
+                    "unknown camera `{name}`, expected one of {}",
+                    names.join(", ")
+                ),
+            ));
+        };
+        let given = [
+            ("fov", c.fov.is_some()),
+            ("fov_axis", c.fov_axis.is_some()),
+            ("screen_window", c.screen_window.is_some()),
+            ("lens_radius", c.lens_radius.is_some()),
+            ("focal_distance", c.focal_distance.is_some()),
+            ("aperture_blades", c.aperture_blades.is_some()),
+            ("aperture_rotation", c.aperture_rotation.is_some()),
+            ("lens_shift", c.lens_shift.is_some()),
+            ("fx", c.fx.is_some()),
+            ("fy", c.fy.is_some()),
+            ("cx", c.cx.is_some()),
+            ("cy", c.cy.is_some()),
+            ("distortion", c.distortion.is_some()),
+            ("projection", c.projection.is_some()),
+            ("face", c.face.is_some()),
+            ("stereo", c.stereo.is_some()),
+        ];
+        for (key, _) in given.iter().filter(|(k, g)| *g && !reads(kind, k)) {
+            ignored.push(format!("camera.{key} is ignored by the {name} camera"));
+        }
+
+        // The pose: a look-at (at shutter open, and at close when the camera moves), or OpenCV
+        // extrinsics, never both.
+        let look_given = [
+            &c.eye,
+            &c.target,
+            &c.up,
+            &c.eye_end,
+            &c.target_end,
+            &c.up_end,
+        ]
+        .iter()
+        .any(|v| v.is_some());
+        let extrinsics = match (c.rvec, c.tvec) {
+            (None, None) => None,
+            (Some(rvec), Some(tvec)) => {
+                if look_given {
+                    return Err(self.err(
+                        "camera.rvec",
+                        "give the pose either as a look-at (eye, target, up) or as OpenCV \
+                         extrinsics (rvec, tvec), not both",
+                    ));
+                }
+                opencv_pose(rvec, tvec).map_err(|e| self.camera_err(e))?;
+                Some(Extrinsics { rvec, tvec })
+            }
+            (Some(_), None) => {
+                return Err(self.err("camera.rvec", "rvec needs tvec beside it"));
+            }
+            (None, Some(_)) => {
+                return Err(self.err("camera.tvec", "tvec needs rvec beside it"));
             }
         };
         let v3 = |key: &str, v: Option<V3>, default: V3| -> Result<V3, RenderError> {
@@ -113,23 +192,11 @@ impl Cx<'_> {
             self.look_at(true, end)?;
         }
 
-        let mut note = |key: &str, given: bool| {
-            if given {
-                ignored.push(format!(
-                    "camera.{key} is ignored by the {} camera",
-                    kind_name(kind)
-                ));
-            }
-        };
         let perspective = kind == CameraKind::Perspective;
-        let projective = kind != CameraKind::Environment;
-        note("fov", !perspective && c.fov.is_some());
-        note("fov_axis", !perspective && c.fov_axis.is_some());
-        note("screen_window", !projective && c.screen_window.is_some());
-        note("lens_radius", !projective && c.lens_radius.is_some());
-        note("focal_distance", !projective && c.focal_distance.is_some());
-
-        let fov = c.fov.unwrap_or(90.0);
+        let fov = c.fov.unwrap_or(match kind {
+            CameraKind::Fisheye => 180.0,
+            _ => 90.0,
+        });
         if perspective {
             validate_fov(fov).map_err(|e| self.camera_err(e))?;
         }
@@ -159,6 +226,94 @@ impl Cx<'_> {
         .map_err(|e| self.camera_err(e))?;
         let shutter = c.shutter.unwrap_or([0.0, 1.0]);
         let shutter = Shutter::new(shutter[0], shutter[1]).map_err(|e| self.camera_err(e))?;
+        if extrinsics.is_some() && end.is_some() {
+            return Err(self.err(
+                "camera.rvec",
+                "OpenCV extrinsics give a fixed pose; a moving camera needs eye_end, target_end \
+                 or up_end with a look-at",
+            ));
+        }
+
+        // The OpenCV models' intrinsics (pixels) and distortion (checked by the model).
+        let opencv = matches!(kind, CameraKind::OpenCv | CameraKind::OpenCvFisheye);
+        let intrinsics = match (c.fx, c.fy, c.cx, c.cy) {
+            (Some(fx), Some(fy), Some(cx), Some(cy)) if opencv => {
+                Some(OpenCvIntrinsics { fx, fy, cx, cy })
+            }
+            _ if opencv => {
+                let missing = [("fx", c.fx), ("fy", c.fy), ("cx", c.cx), ("cy", c.cy)]
+                    .into_iter()
+                    .find(|(_, v)| v.is_none())
+                    .map_or("fx", |(k, _)| k);
+                return Err(self.err(
+                    &format!("camera.{missing}"),
+                    format!(
+                        "an {name} camera needs fx, fy, cx and cy (pixels); {missing} is missing"
+                    ),
+                ));
+            }
+            _ => None,
+        };
+        let distortion = c.distortion.unwrap_or_else(|| vec![0.0; 4]);
+
+        let projection = match c.projection {
+            Some(p) => p
+                .parse::<FisheyeProjection>()
+                .map_err(|e| self.camera_err(e))?,
+            None => FisheyeProjection::Equidistant,
+        };
+        let face = match c.face {
+            Some(f) => f.parse::<CubeFace>().map_err(|e| self.camera_err(e))?,
+            None => CubeFace::PositiveZ,
+        };
+        let lens_shift = c.lens_shift.unwrap_or([0.0, 0.0]);
+        self.finite("camera.lens_shift", &lens_shift)?;
+
+        // [camera.stereo]: an off-axis pair needs its convergence distance; the ODS camera
+        // reads only the interaxial.
+        let stereo = match c.stereo {
+            Some(raw) if reads(kind, "stereo") => {
+                let interaxial = raw.interaxial.unwrap_or(DEFAULT_INTERAXIAL);
+                let convergence = match (raw.convergence, kind) {
+                    (Some(c), _) => c,
+                    (None, CameraKind::Ods) => 1.0,
+                    (None, _) => {
+                        return Err(self.err(
+                            "camera.stereo",
+                            "an off-axis stereo pair needs `convergence`, the distance of its \
+                             zero-parallax plane",
+                        ));
+                    }
+                };
+                if kind == CameraKind::Ods {
+                    for (key, g) in [
+                        ("convergence", raw.convergence.is_some()),
+                        ("layout", raw.layout.is_some()),
+                    ] {
+                        if g {
+                            ignored
+                                .push(format!("camera.stereo.{key} is ignored by the ods camera"));
+                        }
+                    }
+                }
+                let rig =
+                    StereoRig::new(interaxial, convergence).map_err(|e| self.camera_err(e))?;
+                let layout = match raw.layout.as_deref() {
+                    None => StereoLayout::SideBySide,
+                    Some(l) => StereoLayout::from_name(l).ok_or_else(|| {
+                        self.err(
+                            "camera.stereo.layout",
+                            format!(
+                                "unknown layout `{l}`, expected side_by_side, separate or anaglyph"
+                            ),
+                        )
+                    })?,
+                };
+                Some(StereoSettings { rig, layout })
+            }
+            _ => None,
+        };
+
         Ok(CameraSettings {
             kind,
             start,
@@ -170,6 +325,14 @@ impl Cx<'_> {
             far,
             lens,
             shutter,
+            extrinsics,
+            intrinsics,
+            distortion,
+            projection,
+            face,
+            lens_shift,
+            stereo,
+            eye: None,
         })
     }
 
@@ -239,7 +402,7 @@ mod tests {
             ),
         ];
         for (e, key) in cases {
-            assert_eq!(key_of(&e), key, "{e}");
+            assert_eq!(camera_key(&e), key, "{e}");
         }
     }
 

@@ -49,6 +49,10 @@ pub fn parse_description(path: &Path, source: &str) -> Result<SceneDescription, 
     let sampler = cx.sampler(raw.sampler)?;
     let integrator = cx.integrator(raw.integrator)?;
     let camera = cx.camera(raw.camera, &mut ignored)?;
+    // What needs the film too (a fisheye's field of view, a square film) is checked by
+    // building the camera once.
+    crate::build::build_camera(&camera, film.resolution, film.crop)
+        .map_err(|e| cx.camera_err(e))?;
     let mut materials = Vec::new();
     for (name, m) in raw.materials {
         let m = cx.material(&name, m)?;
@@ -76,6 +80,7 @@ pub fn parse_description(path: &Path, source: &str) -> Result<SceneDescription, 
         shapes,
         lights,
         ignored,
+        source: source.into(),
     })
 }
 

@@ -68,6 +68,25 @@ pub(super) struct RawCamera {
     pub(super) eye_end: Option<V3>,
     pub(super) target_end: Option<V3>,
     pub(super) up_end: Option<V3>,
+    pub(super) fx: Option<f64>,
+    pub(super) fy: Option<f64>,
+    pub(super) cx: Option<f64>,
+    pub(super) cy: Option<f64>,
+    pub(super) distortion: Option<Vec<f64>>,
+    pub(super) rvec: Option<[f64; 3]>,
+    pub(super) tvec: Option<[f64; 3]>,
+    pub(super) projection: Option<String>,
+    pub(super) face: Option<String>,
+    pub(super) lens_shift: Option<[f32; 2]>,
+    pub(super) stereo: Option<RawStereo>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawStereo {
+    pub(super) interaxial: Option<f32>,
+    pub(super) convergence: Option<f32>,
+    pub(super) layout: Option<String>,
 }
 
 #[derive(Deserialize)]

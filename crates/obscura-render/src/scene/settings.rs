@@ -1,6 +1,10 @@
 //! The public settings types of a validated scene file.
 
-use obscura_camera::{FovAxis, LookAt, ScreenWindow, Shutter, ThinLens};
+use crate::error::RenderError;
+use obscura_camera::{
+    CubeFace, FisheyeProjection, FovAxis, LookAt, OpenCvIntrinsics, ScreenWindow, Shutter,
+    StereoEye, StereoRig, ThinLens,
+};
 use obscura_sample::SamplerKind;
 use obscura_space::{Object, Transform, World};
 use std::path::PathBuf;
@@ -30,6 +34,22 @@ pub struct SceneDescription {
     /// Keys that were given but that the chosen model ignores (e.g. `fov` on an orthographic
     /// camera): worth a note to the user, not an error.
     pub ignored: Vec<String>,
+    /// The file's text, read once: errors found after parsing (a mesh that fails to load, a
+    /// camera the command line's resolution does not suit) find their key's line in it.
+    pub(crate) source: std::sync::Arc<str>,
+}
+
+impl SceneDescription {
+    /// A scene error at `key`, with the key's line in the file.
+    pub(crate) fn error(&self, key: impl Into<String>, message: impl Into<String>) -> RenderError {
+        let key = key.into();
+        RenderError::Scene {
+            file: self.file.clone(),
+            line: crate::locate::line_of_key(&self.source, &key),
+            key: Some(key),
+            message: message.into(),
+        }
+    }
 }
 
 /// `[film]`: the image's size and reconstruction filter.
@@ -162,6 +182,98 @@ pub enum CameraKind {
     Orthographic,
     /// Equirectangular 360 x 180 degree environment camera.
     Environment,
+    /// OpenCV's pinhole model with distortion (`type = "opencv"`).
+    OpenCv,
+    /// OpenCV's fisheye model, Kannala-Brandt (`type = "opencv_fisheye"`).
+    OpenCvFisheye,
+    /// An ideal fisheye (`type = "fisheye"`, with `projection`).
+    Fisheye,
+    /// A cylindrical panorama, 360 degrees around camera +y.
+    Cylindrical,
+    /// Clarberg's equal-area octahedral panorama of the whole sphere.
+    Octahedral,
+    /// One 90-degree face of a cube map (`face`).
+    CubeFace,
+    /// Omni-directional stereo: both eyes' equirectangular panoramas, left on top.
+    Ods,
+}
+
+impl CameraKind {
+    /// Every model, in the order the scene format lists them.
+    pub const ALL: [CameraKind; 10] = [
+        CameraKind::Perspective,
+        CameraKind::Orthographic,
+        CameraKind::Environment,
+        CameraKind::OpenCv,
+        CameraKind::OpenCvFisheye,
+        CameraKind::Fisheye,
+        CameraKind::Cylindrical,
+        CameraKind::Octahedral,
+        CameraKind::CubeFace,
+        CameraKind::Ods,
+    ];
+
+    /// The model's `type` in the scene file.
+    pub fn name(self) -> &'static str {
+        match self {
+            CameraKind::Perspective => "perspective",
+            CameraKind::Orthographic => "orthographic",
+            CameraKind::Environment => "environment",
+            CameraKind::OpenCv => "opencv",
+            CameraKind::OpenCvFisheye => "opencv_fisheye",
+            CameraKind::Fisheye => "fisheye",
+            CameraKind::Cylindrical => "cylindrical",
+            CameraKind::Octahedral => "octahedral",
+            CameraKind::CubeFace => "cube_face",
+            CameraKind::Ods => "ods",
+        }
+    }
+
+    /// The model of a scene file's `type`.
+    pub fn from_name(name: &str) -> Option<CameraKind> {
+        CameraKind::ALL.into_iter().find(|k| k.name() == name)
+    }
+}
+
+/// OpenCV extrinsics: the pose as `cv::projectPoints` takes it, world -> OpenCV camera.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Extrinsics {
+    /// Rotation as a Rodrigues vector (axis times angle in radians).
+    pub rvec: [f64; 3],
+    /// Translation, world units.
+    pub tvec: [f64; 3],
+}
+
+/// How `obscura render` lays out a stereo pair (`[camera.stereo] layout`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StereoLayout {
+    /// One image twice as wide: left eye on the left.
+    SideBySide,
+    /// Two files, `NAME-left.EXT` and `NAME-right.EXT`.
+    Separate,
+    /// A red-cyan anaglyph: red from the left eye's luminance, green and blue from the right.
+    Anaglyph,
+}
+
+impl StereoLayout {
+    /// The layout of a scene file's name.
+    pub fn from_name(name: &str) -> Option<StereoLayout> {
+        match name {
+            "side_by_side" => Some(StereoLayout::SideBySide),
+            "separate" => Some(StereoLayout::Separate),
+            "anaglyph" => Some(StereoLayout::Anaglyph),
+            _ => None,
+        }
+    }
+}
+
+/// `[camera.stereo]`, validated.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StereoSettings {
+    /// The rig: interaxial and convergence distances.
+    pub rig: StereoRig,
+    /// How the pair is written.
+    pub layout: StereoLayout,
 }
 
 /// `[camera]`, validated: the camera crate's own types, each checked by the camera crate.
@@ -187,6 +299,38 @@ pub struct CameraSettings {
     pub lens: ThinLens,
     /// Shutter open and close times.
     pub shutter: Shutter,
+    /// OpenCV extrinsics `rvec`, `tvec`: when given, the pose instead of the look-at.
+    pub extrinsics: Option<Extrinsics>,
+    /// `fx`, `fy`, `cx`, `cy` of the OpenCV models.
+    pub intrinsics: Option<OpenCvIntrinsics>,
+    /// `distortion` of the OpenCV models, in OpenCV's `distCoeffs` order.
+    pub distortion: Vec<f64>,
+    /// The ideal fisheye's projection.
+    pub projection: FisheyeProjection,
+    /// The cube-map face.
+    pub face: CubeFace,
+    /// Lens shift `[sx, sy]` in fractions of the image (perspective, orthographic, fisheye).
+    pub lens_shift: [f32; 2],
+    /// `[camera.stereo]`: an off-axis pair (perspective) or the ODS viewing circle.
+    pub stereo: Option<StereoSettings>,
+    /// Which eye of the stereo pair this description renders; None for the rig's centre.
+    pub eye: Option<StereoEye>,
+}
+
+impl SceneDescription {
+    /// The two eyes' descriptions of a perspective stereo scene (left, right), each rendering
+    /// one eye's camera; None when the scene has no off-axis pair.
+    pub fn stereo_eyes(&self) -> Option<[SceneDescription; 2]> {
+        if self.camera.stereo.is_none() || self.camera.kind != CameraKind::Perspective {
+            return None;
+        }
+        let eye = |eye| {
+            let mut d = self.clone();
+            d.camera.eye = Some(eye);
+            d
+        };
+        Some([eye(StereoEye::Left), eye(StereoEye::Right)])
+    }
 }
 
 /// A material, validated.
