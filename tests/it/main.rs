@@ -6,6 +6,7 @@ mod gallery;
 mod opencv;
 mod robust;
 mod scenes;
+mod views;
 
 use obscura_render::{
     Image, IntegratorKind, RenderOptions, RenderScene, SceneDescription, load_description, render,

@@ -119,7 +119,7 @@ pub enum CameraError {
     UnknownFisheyeProjection(String),
     /// A fisheye field of view outside its projection's range.
     #[error(
-        "fov of a {projection} fisheye must be in (0, {max}{} degrees, got {got}",
+        "fov of the {projection} fisheye must be in (0, {max}{} degrees, got {got}",
         if *max_inclusive { "]" } else { ")" }
     )]
     FisheyeFov {
@@ -137,7 +137,7 @@ pub enum CameraError {
     UnknownCubeFace(String),
     /// A film whose shape the camera model cannot use (a non-square octahedral or cube-face
     /// film, an ODS film of odd height).
-    #[error("a {model} camera needs {need} film, got {} x {}", got[0], got[1])]
+    #[error("the {model} camera needs {need} film, got {} x {}", got[0], got[1])]
     FilmShape {
         /// The camera model's scene name, e.g. `"octahedral"`.
         model: &'static str,
@@ -168,7 +168,7 @@ pub enum CameraError {
     },
     /// A distortion list of a length the model does not read.
     #[error(
-        "distortion of an {model} camera must have {} entries, got {got}",
+        "distortion of the {model} camera must have {} entries, got {got}",
         if *model == "opencv" { "4, 5, 8 or 12" } else { "4" }
     )]
     DistortionLength {

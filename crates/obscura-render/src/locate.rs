@@ -48,21 +48,23 @@ fn key_on(line: &str) -> Option<&str> {
 pub(crate) fn line_of_key(source: &str, path: &str) -> Option<usize> {
     let lines: Vec<&str> = source.lines().collect();
     let mut header_line = None;
+    // The table's own header beats an enclosing one's (`[camera.stereo]` over `[camera]` for
+    // the key `camera.stereo`).
+    let mut own_header_line = None;
     for (n, header) in headers(source) {
         let rest = if header.is_empty() {
             Some(path)
         } else if path == header {
-            if header_line.is_none() {
-                header_line = Some(n);
-            }
+            own_header_line = own_header_line.or(Some(n));
             None
         } else {
             path.strip_prefix(header.as_str())
                 .and_then(|r| r.strip_prefix('.'))
         };
         let Some(rest) = rest else { continue };
-        if header_line.is_none() && !header.is_empty() {
-            header_line = Some(n.saturating_sub(0));
+        // The innermost enclosing table's header: `[camera.stereo]` over `[camera]`.
+        if !header.is_empty() && header_line.is_none_or(|(len, _)| header.len() > len) {
+            header_line = Some((header.len(), n));
         }
         // The first segment of the rest, without an index: `transform[0].rotate` -> `transform`.
         let first = rest.split(['.', '[']).next().unwrap_or(rest);
@@ -70,7 +72,7 @@ pub(crate) fn line_of_key(source: &str, path: &str) -> Option<usize> {
             return Some(n);
         }
     }
-    header_line
+    own_header_line.or(header_line.map(|(_, n)| n))
 }
 
 /// The key path of the `key = value` line at `line`, qualified by its table: for serde errors,
@@ -105,6 +107,10 @@ mod tests {
         assert_eq!(line_of_key(SCENE, "shapes[0].type"), Some(9));
         assert_eq!(line_of_key(SCENE, "materials.white.reflectance"), Some(15));
         assert_eq!(line_of_key(SCENE, "lights[0]"), None);
+        let nested = "[camera]\nfov = 1.0\n[camera.stereo]\ninteraxial = 0.1\n";
+        assert_eq!(line_of_key(nested, "camera.stereo"), Some(3));
+        assert_eq!(line_of_key(nested, "camera.stereo.interaxial"), Some(4));
+        assert_eq!(line_of_key(nested, "camera.stereo.layout"), Some(3));
     }
 
     #[test]
