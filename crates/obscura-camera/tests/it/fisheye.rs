@@ -181,7 +181,7 @@ fn validation() {
             got: 180.0
         }
         .to_string(),
-        "fov of a orthographic fisheye must be in (0, 180) degrees, got 180"
+        "fov of the orthographic fisheye must be in (0, 180) degrees, got 180"
     );
 }
 

@@ -113,7 +113,7 @@ fn refuses_non_square_films() {
             got: [64, 32]
         }
         .to_string(),
-        "a octahedral camera needs a square film, got 64 x 32"
+        "the octahedral camera needs a square film, got 64 x 32"
     );
 }
 
