@@ -5,16 +5,18 @@
 //! cargo build --release -p obscura-camera --example ray_count
 //! valgrind --tool=callgrind target/release/examples/ray_count perspective 1000000
 //! valgrind --tool=callgrind target/release/examples/ray_count perspective 0
+//! valgrind --tool=callgrind target/release/examples/ray_count perspective 1000000 diff
 //! ```
 //!
 //! The difference of the two totals over `N` is the cost of one ray plus making its sample;
 //! the model `samples` only makes the samples, to subtract. Models: `perspective`,
 //! `perspective-lens`, `orthographic`, `orthographic-lens`, `environment`, each optionally
-//! with a `-moving` suffix (the eye slides along x over the shutter).
+//! with a `-moving` suffix (the eye slides along x over the shutter). A third argument `diff`
+//! generates ray differentials instead of rays, from the same samples.
 
 use obscura_camera::{
-    AnyCamera, Camera, CameraBase, CameraSample, EnvironmentCamera, FilmGeometry, FovAxis, LookAt,
-    OrthographicCamera, PerspectiveCamera, Shutter, ThinLens, look_at_pose,
+    AnyCamera, Camera, CameraBase, CameraRay, CameraSample, EnvironmentCamera, FilmGeometry,
+    FovAxis, LookAt, OrthographicCamera, PerspectiveCamera, Shutter, ThinLens, look_at_pose,
 };
 use obscura_space::{Point2, Point3, Vector3};
 use std::hint::black_box;
@@ -57,11 +59,19 @@ fn camera(name: &str) -> Option<AnyCamera> {
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    let usage = "usage: ray_count MODEL[-moving] N";
+    let usage = "usage: ray_count MODEL[-moving] N [diff]";
     let (Some(name), Some(n)) = (args.get(1), args.get(2).and_then(|n| n.parse::<u32>().ok()))
     else {
         eprintln!("{usage}");
         std::process::exit(2);
+    };
+    let differential = match args.get(3).map(String::as_str) {
+        None => false,
+        Some("diff") => true,
+        Some(mode) => {
+            eprintln!("unknown mode {mode}; {usage}");
+            std::process::exit(2);
+        }
     };
     let camera = camera(name);
     if camera.is_none() && name != "samples" {
@@ -77,11 +87,15 @@ fn main() {
             p_lens: glam::Vec2::new((kf * 0.618_034).fract(), (kf * 0.754_877_7).fract()),
             time: (kf * 0.569_840_3).fract(),
         };
-        let ray = match &camera {
-            Some(camera) => camera.generate_ray(black_box(&sample)),
-            None => black_box(None),
+        // Each result goes through `black_box` whole, so none of its fields is optimised away.
+        let generated = match &camera {
+            Some(camera) if differential => {
+                black_box(camera.generate_ray_differential(black_box(&sample))).is_some()
+            }
+            Some(camera) => black_box(camera.generate_ray(black_box(&sample))).is_some(),
+            None => black_box(None::<CameraRay>).is_some(),
         };
-        if black_box(ray).is_some() {
+        if generated {
             hits += 1;
         }
     }

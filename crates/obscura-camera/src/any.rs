@@ -15,7 +15,10 @@ use crate::perspective::PerspectiveCamera;
 use obscura_space::{AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, World};
 
 /// Any of the camera models, dispatched by `match` (no trait objects on the per-ray path).
+// An explicit one-byte tag: left to rustc, the tag was a niche in a 16-byte field, which made
+// each dispatch (and the `Option<AnyCamera>` check) a 128-bit compare and range computation.
 #[derive(Debug, Clone)]
+#[repr(u8)]
 pub enum AnyCamera {
     /// A perspective camera.
     Perspective(PerspectiveCamera),

@@ -426,20 +426,24 @@ pub(crate) fn ray_time(shutter: Shutter, sample: &CameraSample) -> Option<f32> {
     Some(shutter.time_at(sample.time))
 }
 
-/// The three rays of a differential, from a model's per-ray function `ray(p_film)` (the lens
-/// sample and pose cache already bound): the sample's film point and its neighbours one pixel
-/// right and one pixel down, all at `time`.
+/// The film points of a differential's three rays: the sample's and its neighbours one pixel
+/// right and one pixel down.
 #[inline(always)]
-pub(crate) fn differential_of(
-    sample: &CameraSample,
-    time: f32,
-    ray: impl Fn(Point2<Raster>) -> Ray<World>,
-) -> CameraRayDifferential {
-    let world = |dx: f32, dy: f32| Ray {
-        time,
-        ..ray(Point2::new(sample.p_film.x + dx, sample.p_film.y + dy))
-    };
-    differential(world(0.0, 0.0), world(1.0, 0.0), world(0.0, 1.0))
+pub(crate) fn differential_film_points(p_film: Point2<Raster>) -> [Point2<Raster>; 3] {
+    [
+        Point2::new(p_film.x + 0.0, p_film.y + 0.0),
+        Point2::new(p_film.x + 1.0, p_film.y + 0.0),
+        Point2::new(p_film.x + 0.0, p_film.y + 1.0),
+    ]
+}
+
+/// A differential from the three rays of [`differential_film_points`] (each built at time 0 by
+/// the model's per-ray function), all stamped with `time`. The models call their per-ray
+/// function directly three times rather than through a closure, so that it is inlined.
+#[inline(always)]
+pub(crate) fn differential_at(time: f32, rays: [Ray<World>; 3]) -> CameraRayDifferential {
+    let [ray, rx, ry] = rays;
+    differential(Ray { time, ..ray }, Ray { time, ..rx }, Ray { time, ..ry })
 }
 
 #[cfg(test)]

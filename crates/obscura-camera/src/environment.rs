@@ -1,8 +1,8 @@
 //! The environment (equirectangular) camera.
 
 use crate::camera::{
-    Camera, CameraBase, CameraRay, CameraRayDifferential, CameraSample, PoseFrame, differential_of,
-    is_unit_length, ray_time,
+    Camera, CameraBase, CameraRay, CameraRayDifferential, CameraSample, PoseFrame, differential_at,
+    differential_film_points, is_unit_length, ray_time,
 };
 use crate::error::CameraError;
 use crate::film::{FilmGeometry, Shutter};
@@ -125,6 +125,23 @@ impl EnvironmentCamera {
             t_max,
         }
     }
+
+    /// The three rays of a differential ([`differential_film_points`]) at `time`, with `cache`
+    /// the pose at that time. Calls [`Self::ray`] directly for each (no closure between), so
+    /// that all three are inlined.
+    #[inline(always)]
+    fn differential(
+        &self,
+        cache: &EquirectFrame,
+        sample: &CameraSample,
+        time: f32,
+    ) -> CameraRayDifferential {
+        let [p, px, py] = differential_film_points(sample.p_film);
+        differential_at(
+            time,
+            [self.ray(cache, p), self.ray(cache, px), self.ray(cache, py)],
+        )
+    }
 }
 
 impl Camera for EnvironmentCamera {
@@ -145,10 +162,9 @@ impl Camera for EnvironmentCamera {
     fn generate_ray_differential(&self, sample: &CameraSample) -> Option<CameraRayDifferential> {
         let time = ray_time(self.base.shutter, sample)?;
         // As in generate_ray: the call in each arm keeps the fixed cache read in place.
-        let rays = |cache: &_| differential_of(sample, time, |p_film| self.ray(cache, p_film));
         Some(match &self.fixed {
-            Some(cache) => rays(cache),
-            None => rays(&Self::cache(&self.base.frame_at(time))),
+            Some(cache) => self.differential(cache, sample, time),
+            None => self.differential(&Self::cache(&self.base.frame_at(time)), sample, time),
         })
     }
 

@@ -2,7 +2,7 @@
 
 use crate::camera::{
     Camera, CameraBase, CameraRay, CameraRayDifferential, CameraSample, PoseFrame, ThinLens,
-    differential_of, ray_time,
+    differential_at, differential_film_points, ray_time,
 };
 use crate::error::{CameraError, finite};
 use crate::film::{FilmGeometry, FovAxis, Shutter};
@@ -209,6 +209,27 @@ impl PerspectiveCamera {
             t_max: base.far * per_z,
         }
     }
+
+    /// The three rays of a differential ([`differential_film_points`]) at `time`, with `cache`
+    /// the pose at that time. Calls [`Self::ray`] directly for each (no closure between), so
+    /// that all three are inlined.
+    #[inline(always)]
+    fn differential(
+        &self,
+        cache: &PerspectiveCache,
+        sample: &CameraSample,
+        time: f32,
+    ) -> CameraRayDifferential {
+        let [p, px, py] = differential_film_points(sample.p_film);
+        differential_at(
+            time,
+            [
+                self.ray(cache, p, sample.p_lens),
+                self.ray(cache, px, sample.p_lens),
+                self.ray(cache, py, sample.p_lens),
+            ],
+        )
+    }
 }
 
 impl Camera for PerspectiveCamera {
@@ -233,14 +254,13 @@ impl Camera for PerspectiveCamera {
     fn generate_ray_differential(&self, sample: &CameraSample) -> Option<CameraRayDifferential> {
         let time = ray_time(self.shutter(), sample)?;
         // As in generate_ray: the call in each arm keeps the fixed cache read in place.
-        let rays = |cache: &_| {
-            differential_of(sample, time, |p_film| {
-                self.ray(cache, p_film, sample.p_lens)
-            })
-        };
         Some(match &self.fixed {
-            Some(cache) => rays(cache),
-            None => rays(&Self::cache(&self.projective.base().frame_at(time))),
+            Some(cache) => self.differential(cache, sample, time),
+            None => self.differential(
+                &Self::cache(&self.projective.base().frame_at(time)),
+                sample,
+                time,
+            ),
         })
     }
 
