@@ -1,6 +1,7 @@
-//! The per-ray chain shared by the fisheye, cylindrical, octahedral, cube-face and ODS cameras:
-//! each model supplies only its film -> camera-space ray map (and its forward map for
-//! `project`); this module does the rest of the chain the same way for all of them.
+//! The per-ray chain shared by the fisheye, cylindrical, octahedral, cube-face, ODS and OpenCV
+//! (pinhole and fisheye) cameras: each model supplies only its film -> camera-space ray map
+//! (and its forward map for `project`); this module does the rest of the chain the same way for
+//! all of them.
 //!
 //! The chain: check the sample is finite -> time on the shutter -> the model's camera-space
 //! origin and unit direction (None: no ray leaves this film point) -> clip range `[near, far]`

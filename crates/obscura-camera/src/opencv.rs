@@ -1,14 +1,15 @@
 //! The OpenCV pinhole camera with lens distortion (`cv::projectPoints`), and the OpenCV
 //! extrinsics (`rvec`, `tvec`) as a camera pose. The pieces shared with
-//! [`OpenCvFisheyeCamera`](crate::OpenCvFisheyeCamera) (intrinsics, frames, rays) live here too.
+//! [`OpenCvFisheyeCamera`](crate::OpenCvFisheyeCamera) (intrinsics, frames,
+//! distortion checks) live here too; the per-ray chain is [`crate::chain`]'s.
 
 use crate::camera::{Camera, CameraBase, CameraRay, CameraRayDifferential, CameraSample};
+use crate::chain::{self, CameraRayParts, PoseCache};
 use crate::error::CameraError;
 use crate::film::{FilmGeometry, Shutter};
 use glam::{DMat2, DMat3, DVec2, DVec3};
 use obscura_space::{
-    AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, Ray, Transform, Vector3,
-    World,
+    AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, Transform, World,
 };
 
 /// The pixel intrinsics of an OpenCV camera matrix `K = [fx 0 cx; 0 fy cy; 0 0 1]`, in OpenCV's
@@ -167,101 +168,6 @@ pub fn opencv_pose(
 #[inline]
 pub(crate) fn flip_y(v: DVec3) -> DVec3 {
     DVec3::new(v.x, -v.y, v.z)
-}
-
-/// True when every number of the sample is finite.
-#[inline]
-pub(crate) fn sample_is_finite(sample: &CameraSample) -> bool {
-    sample.p_film.x.is_finite()
-        && sample.p_film.y.is_finite()
-        && sample.p_lens.x.is_finite()
-        && sample.p_lens.y.is_finite()
-        && sample.time.is_finite()
-}
-
-/// The pose at `time`: the cached transform of a fixed pose, else the interpolated one.
-#[inline]
-pub(crate) fn pose_at(
-    base: &CameraBase,
-    fixed: &Option<Transform<World, CameraSpace>>,
-    time: f32,
-) -> Transform<World, CameraSpace> {
-    match fixed {
-        Some(pose) => *pose,
-        None => base.world_from_camera.at(time),
-    }
-}
-
-/// The cached pose of a fixed camera.
-pub(crate) fn fixed_pose(base: &CameraBase) -> Option<Transform<World, CameraSpace>> {
-    (!base.world_from_camera.is_animated()).then(|| base.world_from_camera.at(0.0))
-}
-
-/// Moves a camera-space ray from the eye (unit direction `d`, range `[t_min, t_max]`) to the
-/// world with `pose`, keeping the direction unit: a rigid pose keeps the range, a scaling one
-/// rescales it so that it covers the same points.
-#[inline]
-pub(crate) fn world_ray(
-    pose: &Transform<World, CameraSpace>,
-    d: DVec3,
-    t_min: f32,
-    t_max: f32,
-    time: f32,
-) -> Ray<World> {
-    let ray = pose.ray(Ray::new(
-        Point3::ORIGIN,
-        Vector3::from_glam(d.as_vec3()),
-        time,
-    ));
-    let length = ray.direction.length();
-    let direction = ray.direction / length;
-    let (t_min, t_max) = if (length - 1.0).abs() <= 1e-5 {
-        (t_min, t_max)
-    } else {
-        (t_min * length, t_max * length)
-    };
-    Ray {
-        direction,
-        t_min,
-        t_max,
-        ..ray
-    }
-}
-
-/// The camera-space point of a world point (Obscura frame), in f64.
-#[inline]
-pub(crate) fn camera_point(pose: &Transform<World, CameraSpace>, p: Point3<World>) -> DVec3 {
-    pose.inverse().point(p).to_glam().as_dvec3()
-}
-
-/// A differential from the main ray and the rays of the neighbours one pixel right and down.
-/// A neighbour that gives no ray (past the valid radius) is replaced by the mirror image of
-/// the neighbour on the other side (`2 d - d_other`), and by the main ray when that fails too,
-/// so the footprint stays finite next to the edge of the valid region.
-pub(crate) fn differential_of(
-    main: Ray<World>,
-    ray_at: impl Fn(f32, f32) -> Option<Ray<World>>,
-) -> CameraRayDifferential {
-    let neighbour = |dx: f32, dy: f32| -> (Point3<World>, Vector3<World>) {
-        if let Some(r) = ray_at(dx, dy) {
-            return (r.origin, r.direction);
-        }
-        if let Some(r) = ray_at(-dx, -dy) {
-            let d = (main.direction * 2.0 - r.direction).normalize();
-            return (main.origin, d);
-        }
-        (main.origin, main.direction)
-    };
-    let (rx_origin, rx_direction) = neighbour(1.0, 0.0);
-    let (ry_origin, ry_direction) = neighbour(0.0, 1.0);
-    CameraRayDifferential {
-        ray: main,
-        rx_origin,
-        rx_direction,
-        ry_origin,
-        ry_direction,
-        weight: 1.0,
-    }
 }
 
 /// How far out the fold search of [`OpenCvCamera`] looks, in normalised radius (`tan` of the
@@ -469,7 +375,7 @@ pub struct OpenCvCamera {
     distortion: Distortion,
     coefficients: Vec<f64>,
     r_max: f64,
-    fixed: Option<Transform<World, CameraSpace>>,
+    pose: PoseCache,
 }
 
 impl OpenCvCamera {
@@ -489,14 +395,13 @@ impl OpenCvCamera {
         let coefficients = distortion.to_vec();
         let distortion = Distortion::from_slice(distortion);
         let r_max = distortion.fold_radius();
-        let fixed = fixed_pose(&base);
         Ok(OpenCvCamera {
+            pose: PoseCache::new(&base),
             base,
             intrinsics,
             distortion,
             coefficients,
             r_max,
-            fixed,
         })
     }
 
@@ -623,61 +528,37 @@ impl OpenCvCamera {
         Some(self.intrinsics.raster(d))
     }
 
-    /// The world ray of a raster position at `time`, with the pose.
+    /// The camera-space ray of a raster position: from the eye along the unit direction, None
+    /// past the fold.
     #[inline]
-    fn ray(
-        &self,
-        pose: &Transform<World, CameraSpace>,
-        p_film: Point2<Raster>,
-        time: f32,
-    ) -> Option<Ray<World>> {
-        // Camera-space unit direction (None past the fold).
-        let d = self.direction(p_film)?;
+    fn ray_at(&self, p_film: Point2<Raster>) -> Option<CameraRayParts> {
+        let direction = self.direction(p_film)?;
         // Clip range: camera z in [near, far] is t in [near, far] / d.z along the unit d.
-        let inv_dz = (1.0 / d.z) as f32;
-        // World: the pose, direction renormalised.
-        Some(world_ray(
-            pose,
-            d,
-            self.base.near * inv_dz,
-            self.base.far * inv_dz,
-            time,
-        ))
+        let inv_dz = (1.0 / direction.z) as f32;
+        Some(CameraRayParts {
+            origin: DVec3::ZERO,
+            direction,
+            t_min: self.base.near * inv_dz,
+            t_max: self.base.far * inv_dz,
+        })
     }
 }
 
 impl Camera for OpenCvCamera {
     fn generate_ray(&self, sample: &CameraSample) -> Option<CameraRay> {
-        // The sample must be finite.
-        if !sample_is_finite(sample) {
-            return None;
-        }
-        // Time on the shutter, then the pose at that time.
-        let time = self.base.shutter.time_at(sample.time);
-        let pose = pose_at(&self.base, &self.fixed, time);
-        let ray = self.ray(&pose, sample.p_film, time)?;
-        Some(CameraRay { ray, weight: 1.0 })
+        chain::generate(&self.base, &self.pose, sample, |p| self.ray_at(p))
     }
 
     fn generate_ray_differential(&self, sample: &CameraSample) -> Option<CameraRayDifferential> {
-        if !sample_is_finite(sample) {
-            return None;
-        }
-        let time = self.base.shutter.time_at(sample.time);
-        let pose = pose_at(&self.base, &self.fixed, time);
-        let main = self.ray(&pose, sample.p_film, time)?;
-        Some(differential_of(main, |dx, dy| {
-            let p = Point2::new(sample.p_film.x + dx, sample.p_film.y + dy);
-            self.ray(&pose, p, time)
-        }))
+        chain::generate_differential(&self.base, &self.pose, sample, |p| self.ray_at(p))
     }
 
     fn project(&self, p: Point3<World>, time: f32) -> Option<Point2<Raster>> {
         if !time.is_finite() {
             return None;
         }
-        let pose = pose_at(&self.base, &self.fixed, time);
-        let r = self.project_camera(camera_point(&pose, p))?;
+        let v = chain::camera_point(&self.base, &self.pose, p, time);
+        let r = self.project_camera(v)?;
         Some(Point2::new(r.x as f32, r.y as f32))
     }
 

@@ -1,17 +1,13 @@
 //! The OpenCV fisheye camera (Kannala-Brandt, `cv::fisheye::projectPoints`).
 
 use crate::camera::{Camera, CameraBase, CameraRay, CameraRayDifferential, CameraSample};
+use crate::chain::{self, CameraRayParts, PoseCache};
 use crate::error::CameraError;
 use crate::film::{FilmGeometry, Shutter};
-use crate::opencv::{
-    OpenCvIntrinsics, camera_point, check_distortion, differential_of, fixed_pose, flip_y, pose_at,
-    sample_is_finite, world_ray,
-};
+use crate::opencv::{OpenCvIntrinsics, check_distortion, flip_y};
 use core::f64::consts::PI;
 use glam::{DVec2, DVec3};
-use obscura_space::{
-    AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, Ray, Transform, World,
-};
+use obscura_space::{AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, World};
 
 /// The inverse accepts an angle whose re-projection is within this many pixels (in f64); the
 /// stated tolerance is 1e-4 px, this is the margin the solver actually keeps.
@@ -57,7 +53,7 @@ pub struct OpenCvFisheyeCamera {
     theta_max: f64,
     /// `theta_d(theta_max)`: the largest distorted radius with a ray.
     theta_d_max: f64,
-    fixed: Option<Transform<World, CameraSpace>>,
+    pose: PoseCache,
 }
 
 impl OpenCvFisheyeCamera {
@@ -76,14 +72,13 @@ impl OpenCvFisheyeCamera {
         check_distortion("opencv_fisheye", distortion, &[4])?;
         let k = [distortion[0], distortion[1], distortion[2], distortion[3]];
         let theta_max = fold_angle(&k);
-        let fixed = fixed_pose(&base);
         Ok(OpenCvFisheyeCamera {
+            pose: PoseCache::new(&base),
             base,
             intrinsics,
             k,
             theta_max,
             theta_d_max: theta_d(&k, theta_max).0,
-            fixed,
         })
     }
 
@@ -163,13 +158,8 @@ impl OpenCvFisheyeCamera {
     /// The raster position (f64) of a camera-space point (Obscura frame), or None at the eye,
     /// outside `[near, far]` in distance, or at or past the fold angle.
     pub fn project_camera(&self, p: DVec3) -> Option<DVec2> {
-        let distance = p.length();
-        let near = f64::from(self.base.near);
-        let far = f64::from(self.base.far);
-        if !(distance > 0.0 && distance >= near && distance <= far) {
-            return None;
-        }
-        let p_cv = flip_y(p);
+        // A unit direction within the clip range (the angles do not depend on the length).
+        let p_cv = flip_y(chain::direction_within_clip(&self.base, p)?);
         let r = p_cv.x.hypot(p_cv.y);
         let theta = r.atan2(p_cv.z);
         if theta.is_nan() || theta >= self.theta_max {
@@ -184,18 +174,16 @@ impl OpenCvFisheyeCamera {
         Some(self.intrinsics.raster(q))
     }
 
-    /// The world ray of a raster position at `time`, with the pose.
+    /// The camera-space ray of a raster position: from the eye along the unit direction,
+    /// clipped by distance; None past the fold.
     #[inline]
-    fn ray(
-        &self,
-        pose: &Transform<World, CameraSpace>,
-        p_film: Point2<Raster>,
-        time: f32,
-    ) -> Option<Ray<World>> {
-        // Camera-space unit direction (None past the fold).
-        let d = self.direction(p_film)?;
-        // Clip range: a distance along the unit direction. World: the pose, renormalised.
-        Some(world_ray(pose, d, self.base.near, self.base.far, time))
+    fn ray_at(&self, p_film: Point2<Raster>) -> Option<CameraRayParts> {
+        let direction = self.direction(p_film)?;
+        Some(CameraRayParts::by_distance(
+            DVec3::ZERO,
+            direction,
+            &self.base,
+        ))
     }
 }
 
@@ -240,36 +228,19 @@ fn fold_angle(k: &[f64; 4]) -> f64 {
 
 impl Camera for OpenCvFisheyeCamera {
     fn generate_ray(&self, sample: &CameraSample) -> Option<CameraRay> {
-        // The sample must be finite.
-        if !sample_is_finite(sample) {
-            return None;
-        }
-        // Time on the shutter, then the pose at that time.
-        let time = self.base.shutter.time_at(sample.time);
-        let pose = pose_at(&self.base, &self.fixed, time);
-        let ray = self.ray(&pose, sample.p_film, time)?;
-        Some(CameraRay { ray, weight: 1.0 })
+        chain::generate(&self.base, &self.pose, sample, |p| self.ray_at(p))
     }
 
     fn generate_ray_differential(&self, sample: &CameraSample) -> Option<CameraRayDifferential> {
-        if !sample_is_finite(sample) {
-            return None;
-        }
-        let time = self.base.shutter.time_at(sample.time);
-        let pose = pose_at(&self.base, &self.fixed, time);
-        let main = self.ray(&pose, sample.p_film, time)?;
-        Some(differential_of(main, |dx, dy| {
-            let p = Point2::new(sample.p_film.x + dx, sample.p_film.y + dy);
-            self.ray(&pose, p, time)
-        }))
+        chain::generate_differential(&self.base, &self.pose, sample, |p| self.ray_at(p))
     }
 
     fn project(&self, p: Point3<World>, time: f32) -> Option<Point2<Raster>> {
         if !time.is_finite() {
             return None;
         }
-        let pose = pose_at(&self.base, &self.fixed, time);
-        let r = self.project_camera(camera_point(&pose, p))?;
+        let v = chain::camera_point(&self.base, &self.pose, p, time);
+        let r = self.project_camera(v)?;
         Some(Point2::new(r.x as f32, r.y as f32))
     }
 
