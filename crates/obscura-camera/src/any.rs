@@ -1,10 +1,9 @@
 //! The closed set of camera models as one enum.
 
-use crate::camera::{Camera, CameraRay, CameraRayDifferential, CameraSample};
+use crate::camera::{Camera, CameraBase, CameraRay, CameraRayDifferential, CameraSample};
 use crate::cube_face::CubeFaceCamera;
 use crate::cylindrical::CylindricalCamera;
 use crate::environment::EnvironmentCamera;
-use crate::film::{FilmGeometry, Shutter};
 use crate::fisheye::FisheyeCamera;
 use crate::octahedral::OctahedralCamera;
 use crate::ods::OdsCamera;
@@ -12,7 +11,7 @@ use crate::opencv::OpenCvCamera;
 use crate::opencv_fisheye::OpenCvFisheyeCamera;
 use crate::orthographic::OrthographicCamera;
 use crate::perspective::PerspectiveCamera;
-use obscura_space::{AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, World};
+use obscura_space::{Point2, Point3, Raster, World};
 
 /// Any of the camera models, dispatched by `match` (no trait objects on the per-ray path).
 // An explicit one-byte tag: left to rustc, the tag was a niche in a 16-byte field, which made
@@ -73,16 +72,8 @@ impl Camera for AnyCamera {
         dispatch!(self, c => c.project(p, time))
     }
     #[inline]
-    fn film(&self) -> &FilmGeometry {
-        dispatch!(self, c => c.film())
-    }
-    #[inline]
-    fn shutter(&self) -> Shutter {
-        dispatch!(self, c => c.shutter())
-    }
-    #[inline]
-    fn world_from_camera(&self) -> &AnimatedTransform<World, CameraSpace> {
-        dispatch!(self, c => c.world_from_camera())
+    fn base(&self) -> &CameraBase {
+        dispatch!(self, c => c.base())
     }
     #[inline]
     fn uses_lens_sample(&self) -> bool {

@@ -104,14 +104,27 @@ pub trait Camera: Send + Sync {
     /// screen velocities).
     fn project(&self, p: Point3<World>, time: f32) -> Option<Point2<Raster>>;
 
+    /// What every model has: the pose over the shutter, the shutter, the film and the clip
+    /// range. The accessors below read it.
+    fn base(&self) -> &CameraBase;
+
     /// The film geometry: resolution, screen window, crop.
-    fn film(&self) -> &FilmGeometry;
+    #[inline]
+    fn film(&self) -> &FilmGeometry {
+        &self.base().film
+    }
 
     /// The shutter interval.
-    fn shutter(&self) -> Shutter;
+    #[inline]
+    fn shutter(&self) -> Shutter {
+        self.base().shutter
+    }
 
     /// The camera's pose over the shutter interval.
-    fn world_from_camera(&self) -> &AnimatedTransform<World, CameraSpace>;
+    #[inline]
+    fn world_from_camera(&self) -> &AnimatedTransform<World, CameraSpace> {
+        &self.base().world_from_camera
+    }
 
     /// Whether rays depend on [`CameraSample::p_lens`]: true for a thin lens with an
     /// aperture. When false, every lens sample gives the same ray, so a renderer may leave

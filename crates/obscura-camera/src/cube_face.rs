@@ -3,10 +3,9 @@
 use crate::camera::{Camera, CameraBase, CameraRay, CameraRayDifferential, CameraSample};
 use crate::chain::{self, CameraRayParts, PoseCache};
 use crate::error::CameraError;
-use crate::film::{FilmGeometry, Shutter};
 use core::str::FromStr;
 use glam::DVec3;
-use obscura_space::{AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, World};
+use obscura_space::{Point2, Point3, Raster, World};
 
 /// A face of a cube map, named by its major axis.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -189,6 +188,11 @@ impl CubeFaceCamera {
 }
 
 impl Camera for CubeFaceCamera {
+    #[inline]
+    fn base(&self) -> &CameraBase {
+        &self.base
+    }
+
     fn generate_ray(&self, sample: &CameraSample) -> Option<CameraRay> {
         chain::generate(&self.base, &self.pose, sample, |p| self.ray_at(p))
     }
@@ -211,18 +215,6 @@ impl Camera for CubeFaceCamera {
             (0.5 * width * (sc / ma + 1.0)) as f32,
             (0.5 * height * (tc / ma + 1.0)) as f32,
         ))
-    }
-
-    fn film(&self) -> &FilmGeometry {
-        &self.base.film
-    }
-
-    fn shutter(&self) -> Shutter {
-        self.base.shutter
-    }
-
-    fn world_from_camera(&self) -> &AnimatedTransform<World, CameraSpace> {
-        &self.base.world_from_camera
     }
 
     fn uses_lens_sample(&self) -> bool {

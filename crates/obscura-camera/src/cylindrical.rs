@@ -3,10 +3,9 @@
 use crate::camera::{Camera, CameraBase, CameraRay, CameraRayDifferential, CameraSample};
 use crate::chain::{self, CameraRayParts, PoseCache};
 use crate::error::{CameraError, finite};
-use crate::film::{FilmGeometry, Shutter};
 use core::f64::consts::TAU;
 use glam::DVec3;
-use obscura_space::{AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, World};
+use obscura_space::{Point2, Point3, Raster, World};
 
 /// A 360-degree cylindrical panorama around camera +y: columns are the environment camera's
 /// azimuths, rows are linear in height on the unit-radius cylinder around the eye (the central
@@ -76,6 +75,11 @@ impl CylindricalCamera {
 }
 
 impl Camera for CylindricalCamera {
+    #[inline]
+    fn base(&self) -> &CameraBase {
+        &self.base
+    }
+
     fn generate_ray(&self, sample: &CameraSample) -> Option<CameraRay> {
         chain::generate(&self.base, &self.pose, sample, |p| self.ray_at(p))
     }
@@ -100,18 +104,6 @@ impl Camera for CylindricalCamera {
             (width * (phi / TAU + 0.5)) as f32,
             (0.5 * height * (1.0 - h / self.tan_half_fov)) as f32,
         ))
-    }
-
-    fn film(&self) -> &FilmGeometry {
-        &self.base.film
-    }
-
-    fn shutter(&self) -> Shutter {
-        self.base.shutter
-    }
-
-    fn world_from_camera(&self) -> &AnimatedTransform<World, CameraSpace> {
-        &self.base.world_from_camera
     }
 
     fn uses_lens_sample(&self) -> bool {

@@ -5,13 +5,10 @@ use crate::camera::{
     differential_film_points, is_unit_length, ray_time,
 };
 use crate::error::CameraError;
-use crate::film::{FilmGeometry, Shutter};
 use core::f32::consts::{PI, TAU};
 use glam::{Vec2, Vec3, Vec3A, Vec4};
 use obscura_sample::sin_cos_pi_vec4;
-use obscura_space::{
-    AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, Ray, Vector3, World,
-};
+use obscura_space::{Camera as CameraSpace, Point2, Point3, Raster, Ray, Vector3, World};
 
 /// A 360 x 180 degree camera: every ray starts at the eye, and raster `(x, y)` maps to the
 /// direction of SCENE_FORMAT.md, polar angle `theta = pi * y / height` from camera +y and
@@ -146,6 +143,11 @@ impl EnvironmentCamera {
 
 impl Camera for EnvironmentCamera {
     #[inline]
+    fn base(&self) -> &CameraBase {
+        &self.base
+    }
+
+    #[inline]
     fn generate_ray(&self, sample: &CameraSample) -> Option<CameraRay> {
         let time = ray_time(self.base.shutter, sample)?;
         // The call in each arm (not through one merged cache reference) lets LLVM keep the
@@ -180,21 +182,6 @@ impl Camera for EnvironmentCamera {
         let phi = d_camera.x.atan2(d_camera.z);
         let [width, height] = self.base.film.resolution().map(|r| r as f32);
         Some(Point2::new(width * (phi / TAU + 0.5), height * theta / PI))
-    }
-
-    #[inline]
-    fn film(&self) -> &FilmGeometry {
-        &self.base.film
-    }
-
-    #[inline]
-    fn shutter(&self) -> Shutter {
-        self.base.shutter
-    }
-
-    #[inline]
-    fn world_from_camera(&self) -> &AnimatedTransform<World, CameraSpace> {
-        &self.base.world_from_camera
     }
 
     #[inline]

@@ -3,10 +3,9 @@
 use crate::camera::{Camera, CameraBase, CameraRay, CameraRayDifferential, CameraSample};
 use crate::chain::{self, CameraRayParts, PoseCache};
 use crate::error::{CameraError, finite};
-use crate::film::{FilmGeometry, Shutter};
 use core::str::FromStr;
 use glam::DVec3;
-use obscura_space::{AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, World};
+use obscura_space::{Point2, Point3, Raster, World};
 
 /// How far past half the field of view (radians) [`Camera::project`] still maps a direction:
 /// the f32 rounding of a rim ray taken to the world and back.
@@ -229,6 +228,11 @@ impl FisheyeCamera {
 }
 
 impl Camera for FisheyeCamera {
+    #[inline]
+    fn base(&self) -> &CameraBase {
+        &self.base
+    }
+
     fn generate_ray(&self, sample: &CameraSample) -> Option<CameraRay> {
         chain::generate(&self.base, &self.pose, sample, |p| self.ray_at(p))
     }
@@ -258,18 +262,6 @@ impl Camera for FisheyeCamera {
             (self.centre[0] + r * cos_psi) as f32,
             (self.centre[1] - r * sin_psi) as f32,
         ))
-    }
-
-    fn film(&self) -> &FilmGeometry {
-        &self.base.film
-    }
-
-    fn shutter(&self) -> Shutter {
-        self.base.shutter
-    }
-
-    fn world_from_camera(&self) -> &AnimatedTransform<World, CameraSpace> {
-        &self.base.world_from_camera
     }
 
     fn uses_lens_sample(&self) -> bool {

@@ -3,10 +3,9 @@
 use crate::camera::{Camera, CameraBase, CameraRay, CameraRayDifferential, CameraSample};
 use crate::chain::{self, CameraRayParts, PoseCache};
 use crate::error::CameraError;
-use crate::film::{FilmGeometry, Shutter};
 use core::f64::consts::{FRAC_2_PI, FRAC_PI_4};
 use glam::DVec3;
-use obscura_space::{AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, World};
+use obscura_space::{Point2, Point3, Raster, World};
 
 /// The whole sphere on a square image by Clarberg's equal-area octahedral map (Petrik
 /// Clarberg, "Fast Equal-Area Mapping of the (Hemi)Sphere using SIMD", Journal of Graphics
@@ -129,6 +128,11 @@ impl OctahedralCamera {
 }
 
 impl Camera for OctahedralCamera {
+    #[inline]
+    fn base(&self) -> &CameraBase {
+        &self.base
+    }
+
     fn generate_ray(&self, sample: &CameraSample) -> Option<CameraRay> {
         chain::generate(&self.base, &self.pose, sample, |p| self.ray_at(p))
     }
@@ -148,18 +152,6 @@ impl Camera for OctahedralCamera {
             (0.5 * width * (u + 1.0)) as f32,
             (0.5 * height * (1.0 - v)) as f32,
         ))
-    }
-
-    fn film(&self) -> &FilmGeometry {
-        &self.base.film
-    }
-
-    fn shutter(&self) -> Shutter {
-        self.base.shutter
-    }
-
-    fn world_from_camera(&self) -> &AnimatedTransform<World, CameraSpace> {
-        &self.base.world_from_camera
     }
 
     fn uses_lens_sample(&self) -> bool {

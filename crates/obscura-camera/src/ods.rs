@@ -3,10 +3,9 @@
 use crate::camera::{Camera, CameraBase, CameraRay, CameraRayDifferential, CameraSample};
 use crate::chain::{self, CameraRayParts, PoseCache};
 use crate::error::{CameraError, finite};
-use crate::film::{FilmGeometry, Shutter};
 use core::f64::consts::{PI, TAU};
 use glam::DVec3;
-use obscura_space::{AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, World};
+use obscura_space::{Point2, Point3, Raster, World};
 
 /// One eye of an ODS panorama.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -173,6 +172,11 @@ impl OdsCamera {
 }
 
 impl Camera for OdsCamera {
+    #[inline]
+    fn base(&self) -> &CameraBase {
+        &self.base
+    }
+
     fn generate_ray(&self, sample: &CameraSample) -> Option<CameraRay> {
         let eye = self.eye_of(sample.p_film);
         chain::generate(&self.base, &self.pose, sample, |p| self.ray_at(eye, p))
@@ -187,18 +191,6 @@ impl Camera for OdsCamera {
 
     fn project(&self, p: Point3<World>, time: f32) -> Option<Point2<Raster>> {
         self.project_eye(p, time, OdsEye::Left)
-    }
-
-    fn film(&self) -> &FilmGeometry {
-        &self.base.film
-    }
-
-    fn shutter(&self) -> Shutter {
-        self.base.shutter
-    }
-
-    fn world_from_camera(&self) -> &AnimatedTransform<World, CameraSpace> {
-        &self.base.world_from_camera
     }
 
     fn uses_lens_sample(&self) -> bool {

@@ -6,7 +6,6 @@
 use crate::camera::{Camera, CameraBase, CameraRay, CameraRayDifferential, CameraSample};
 use crate::chain::{self, CameraRayParts, PoseCache};
 use crate::error::CameraError;
-use crate::film::{FilmGeometry, Shutter};
 use glam::{DMat2, DMat3, DVec2, DVec3};
 use obscura_space::{
     AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, Transform, World,
@@ -545,6 +544,11 @@ impl OpenCvCamera {
 }
 
 impl Camera for OpenCvCamera {
+    #[inline]
+    fn base(&self) -> &CameraBase {
+        &self.base
+    }
+
     fn generate_ray(&self, sample: &CameraSample) -> Option<CameraRay> {
         chain::generate(&self.base, &self.pose, sample, |p| self.ray_at(p))
     }
@@ -560,18 +564,6 @@ impl Camera for OpenCvCamera {
         let v = chain::camera_point(&self.base, &self.pose, p, time);
         let r = self.project_camera(v)?;
         Some(Point2::new(r.x as f32, r.y as f32))
-    }
-
-    fn film(&self) -> &FilmGeometry {
-        &self.base.film
-    }
-
-    fn shutter(&self) -> Shutter {
-        self.base.shutter
-    }
-
-    fn world_from_camera(&self) -> &AnimatedTransform<World, CameraSpace> {
-        &self.base.world_from_camera
     }
 
     fn uses_lens_sample(&self) -> bool {

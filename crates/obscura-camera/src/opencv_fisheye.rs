@@ -3,11 +3,10 @@
 use crate::camera::{Camera, CameraBase, CameraRay, CameraRayDifferential, CameraSample};
 use crate::chain::{self, CameraRayParts, PoseCache};
 use crate::error::CameraError;
-use crate::film::{FilmGeometry, Shutter};
 use crate::opencv::{OpenCvIntrinsics, check_distortion, flip_y};
 use core::f64::consts::PI;
 use glam::{DVec2, DVec3};
-use obscura_space::{AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, World};
+use obscura_space::{Point2, Point3, Raster, World};
 
 /// The inverse accepts an angle whose re-projection is within this many pixels (in f64); the
 /// stated tolerance is 1e-4 px, this is the margin the solver actually keeps.
@@ -227,6 +226,11 @@ fn fold_angle(k: &[f64; 4]) -> f64 {
 }
 
 impl Camera for OpenCvFisheyeCamera {
+    #[inline]
+    fn base(&self) -> &CameraBase {
+        &self.base
+    }
+
     fn generate_ray(&self, sample: &CameraSample) -> Option<CameraRay> {
         chain::generate(&self.base, &self.pose, sample, |p| self.ray_at(p))
     }
@@ -242,18 +246,6 @@ impl Camera for OpenCvFisheyeCamera {
         let v = chain::camera_point(&self.base, &self.pose, p, time);
         let r = self.project_camera(v)?;
         Some(Point2::new(r.x as f32, r.y as f32))
-    }
-
-    fn film(&self) -> &FilmGeometry {
-        &self.base.film
-    }
-
-    fn shutter(&self) -> Shutter {
-        self.base.shutter
-    }
-
-    fn world_from_camera(&self) -> &AnimatedTransform<World, CameraSpace> {
-        &self.base.world_from_camera
     }
 
     fn uses_lens_sample(&self) -> bool {

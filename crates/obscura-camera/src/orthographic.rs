@@ -5,12 +5,9 @@ use crate::camera::{
     differential_at, differential_film_points, is_unit_length, ray_time,
 };
 use crate::error::CameraError;
-use crate::film::{FilmGeometry, Shutter};
 use crate::projective::{ProjectiveCamera, from_rows};
 use glam::{Vec2, Vec3, Vec3A};
-use obscura_space::{
-    AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, Ray, Vector3, World,
-};
+use obscura_space::{Point2, Point3, Raster, Ray, Vector3, World};
 
 /// An orthographic camera: a parallel projection of the box between `near` and `far` whose
 /// cross-section is the screen window, in camera-space world units. Rays start on the plane
@@ -198,6 +195,11 @@ impl OrthographicCamera {
 
 impl Camera for OrthographicCamera {
     #[inline]
+    fn base(&self) -> &CameraBase {
+        self.projective.base()
+    }
+
+    #[inline]
     fn generate_ray(&self, sample: &CameraSample) -> Option<CameraRay> {
         let time = ray_time(self.shutter(), sample)?;
         // The call in each arm (not through one merged cache reference) lets LLVM keep the
@@ -234,21 +236,6 @@ impl Camera for OrthographicCamera {
     fn project(&self, p: Point3<World>, time: f32) -> Option<Point2<Raster>> {
         let camera_from_world = self.projective.base().pose(time).inverse();
         self.projective.project_camera(camera_from_world.point(p))
-    }
-
-    #[inline]
-    fn film(&self) -> &FilmGeometry {
-        &self.projective.base().film
-    }
-
-    #[inline]
-    fn shutter(&self) -> Shutter {
-        self.projective.base().shutter
-    }
-
-    #[inline]
-    fn world_from_camera(&self) -> &AnimatedTransform<World, CameraSpace> {
-        &self.projective.base().world_from_camera
     }
 
     #[inline]

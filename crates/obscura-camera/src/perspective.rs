@@ -5,12 +5,10 @@ use crate::camera::{
     differential_at, differential_film_points, ray_time,
 };
 use crate::error::{CameraError, finite};
-use crate::film::{FilmGeometry, FovAxis, Shutter};
+use crate::film::FovAxis;
 use crate::projective::{ProjectiveCamera, from_rows};
 use glam::{Vec2, Vec3, Vec3A};
-use obscura_space::{
-    AnimatedTransform, Camera as CameraSpace, Point2, Point3, Raster, Ray, Vector3, World,
-};
+use obscura_space::{Point2, Point3, Raster, Ray, Vector3, World};
 
 /// A perspective camera: the projection plane at camera z = 1 scaled so that the field of view
 /// spans the screen window's half-extent along [`FovAxis`]; rays from the eye (or, with a thin
@@ -234,6 +232,11 @@ impl PerspectiveCamera {
 
 impl Camera for PerspectiveCamera {
     #[inline]
+    fn base(&self) -> &CameraBase {
+        self.projective.base()
+    }
+
+    #[inline]
     fn generate_ray(&self, sample: &CameraSample) -> Option<CameraRay> {
         let time = ray_time(self.shutter(), sample)?;
         // The call in each arm (not through one merged cache reference) lets LLVM keep the
@@ -267,21 +270,6 @@ impl Camera for PerspectiveCamera {
     fn project(&self, p: Point3<World>, time: f32) -> Option<Point2<Raster>> {
         let camera_from_world = self.projective.base().pose(time).inverse();
         self.projective.project_camera(camera_from_world.point(p))
-    }
-
-    #[inline]
-    fn film(&self) -> &FilmGeometry {
-        &self.projective.base().film
-    }
-
-    #[inline]
-    fn shutter(&self) -> Shutter {
-        self.projective.base().shutter
-    }
-
-    #[inline]
-    fn world_from_camera(&self) -> &AnimatedTransform<World, CameraSpace> {
-        &self.projective.base().world_from_camera
     }
 
     #[inline]
