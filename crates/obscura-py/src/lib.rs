@@ -70,8 +70,11 @@ fn numeric_array<'py>(
             "{name}: expected an array of floats or integers, got dtype {dt}"
         )));
     }
-    // astype in C order keeps a 0-d array 0-d (ascontiguousarray would make it 1-d).
-    arr.call_method1("astype", (dtype, "C"))
+    // asarray copies only when the dtype or the layout differ, and keeps a 0-d array 0-d.
+    let kwargs = pyo3::types::PyDict::new(obj.py());
+    kwargs.set_item("dtype", dtype)?;
+    kwargs.set_item("order", "C")?;
+    np.call_method("asarray", (arr,), Some(&kwargs))
 }
 
 /// `(3, 2)`: a shape as Python writes it.
@@ -99,7 +102,11 @@ fn f32_values(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<(Vec<f32>, Vec<usi
     let arr = numeric_array(obj, name, "float32")?;
     let shape = shape_of(&arr)?;
     let ro: PyReadonlyArrayDyn<'_, f32> = arr.extract()?;
-    Ok((ro.as_array().iter().copied().collect(), shape))
+    let values = match ro.as_slice() {
+        Ok(slice) => slice.to_vec(),
+        Err(_) => ro.as_array().iter().copied().collect(),
+    };
+    Ok((values, shape))
 }
 
 /// Values of `obj` as f64, flattened, with its shape.
@@ -107,21 +114,29 @@ fn f64_values(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<(Vec<f64>, Vec<usi
     let arr = numeric_array(obj, name, "float64")?;
     let shape = shape_of(&arr)?;
     let ro: PyReadonlyArrayDyn<'_, f64> = arr.extract()?;
-    Ok((ro.as_array().iter().copied().collect(), shape))
+    let values = match ro.as_slice() {
+        Ok(slice) => slice.to_vec(),
+        Err(_) => ro.as_array().iter().copied().collect(),
+    };
+    Ok((values, shape))
 }
 
 /// `(N, C)` rows of finite f32 values; ValueError naming the argument for another shape or a
 /// NaN/infinity.
 fn rows<const C: usize>(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<[f32; C]>> {
-    let (values, shape) = f32_values(obj, name)?;
+    let arr = numeric_array(obj, name, "float32")?;
+    let shape = shape_of(&arr)?;
     if shape.len() != 2 || shape[1] != C {
         return Err(PyValueError::new_err(format!(
             "{name}: expected an array of shape (N, {C}), got shape {}",
             shape_str(&shape)
         )));
     }
-    check_finite(&values, name, C)?;
-    Ok(values
+    // One pass from numpy's buffer (C-contiguous after numeric_array) to rows.
+    let ro: PyReadonlyArrayDyn<'_, f32> = arr.extract()?;
+    let slice = ro.as_slice()?;
+    check_finite(slice, name, C)?;
+    Ok(slice
         .chunks_exact(C)
         .map(|c| std::array::from_fn(|k| c[k]))
         .collect())
