@@ -234,9 +234,9 @@ pub struct PyCamera {
 /// The scene format's default sampler (`[sampler] type` absent).
 const DEFAULT_SAMPLER: SamplerKind = SamplerKind::Sobol;
 
-/// Reads a scene description from a path or from TOML text: a `str` without a newline that
-/// names an existing file, or any `os.PathLike`, is read as a file; anything else is parsed
-/// as the text of a scene file.
+/// Reads a scene description from a path or from TOML text: an `os.PathLike`, or a one-line
+/// `str` that names an existing file or has no `=` (so cannot be a scene), is read as a file;
+/// any other `str` is parsed as the text of a scene file (errors then name `<string>`).
 fn description_of(obj: &Bound<'_, PyAny>) -> PyResult<SceneDescription> {
     if let Ok(text) = obj.extract::<String>() {
         let as_path = Path::new(&text);
