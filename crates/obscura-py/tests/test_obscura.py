@@ -382,3 +382,28 @@ def test_bad_render_arguments(perspective_scene):
         obscura.render(3.5)
     with pytest.raises(ValueError, match="spp"):
         obscura.Camera.from_toml(scene_text(MODELS["perspective"])).pixel_rays(spp=0)
+
+
+@pytest.mark.parametrize("fisheye", [False, True])
+def test_project_equals_opencv_project_points(fisheye):
+    """OpenCV's own projectPoints (when cv2 is installed, as .ci/run does) against project."""
+    cv2 = pytest.importorskip("cv2")
+    K = np.array([[420.0, 0.0, 321.0], [0.0, 410.0, 238.0], [0.0, 0.0, 1.0]])
+    rvec = np.array([[0.2], [-0.1], [0.05]])
+    tvec = np.array([[0.1], [0.2], [1.5]])
+    rng = np.random.default_rng(11)
+    pc = np.column_stack(
+        [rng.uniform(-0.6, 0.6, 400), rng.uniform(-0.5, 0.5, 400), rng.uniform(1, 6, 400)]
+    )
+    world = (pc - tvec.ravel()) @ rodrigues(rvec.ravel())
+    if fisheye:
+        D = np.array([0.05, -0.01, 0.002, -0.0003])
+        cam = obscura.Camera.from_opencv_fisheye(K, D, rvec, tvec, (640, 480))
+        expect, _ = cv2.fisheye.projectPoints(world.reshape(-1, 1, 3), rvec, tvec, K, D)
+    else:
+        D = np.array([-0.28, 0.09, 0.0012, -0.0007, -0.01])
+        cam = obscura.Camera.from_opencv(K, D, rvec, tvec, (640, 480))
+        expect, _ = cv2.projectPoints(world, rvec, tvec, K, D)
+    xy, ok = cam.project(world.astype(np.float32))
+    assert ok.all()
+    np.testing.assert_allclose(xy, expect.reshape(-1, 2) + 0.5, atol=2e-3)
