@@ -57,8 +57,7 @@ impl RenderScene {
     pub fn build(description: SceneDescription) -> Result<RenderScene, RenderError> {
         let d = &description;
         check_memory(d)?;
-        let camera = build_camera(&d.camera, d.film.resolution, d.film.crop)
-            .map_err(|e| d.error(camera_key(&e), e.to_string()))?;
+        let camera = camera_of(d)?;
         let [x0, x1, y0, y1] = obscura_camera::Camera::film(&camera).pixel_bounds();
         let pixel_bounds = PixelRect { x0, y0, x1, y1 };
 
@@ -257,6 +256,13 @@ fn material(m: MaterialSettings) -> Material {
             roughness,
         },
     }
+}
+
+/// The camera of a scene description alone, with the errors [`RenderScene::build`] gives for
+/// it (naming the file, the `camera.*` or `film.*` key and the line); builds no geometry.
+pub fn camera_of(d: &SceneDescription) -> Result<AnyCamera, RenderError> {
+    build_camera(&d.camera, d.film.resolution, d.film.crop)
+        .map_err(|e| d.error(camera_key(&e), e.to_string()))
 }
 
 pub(crate) fn build_camera(

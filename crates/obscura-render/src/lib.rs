@@ -60,7 +60,7 @@ mod render;
 mod scene;
 mod stereo;
 
-pub use build::{BYTES_PER_PIXEL, DEFAULT_MATERIAL, RenderScene, human_bytes};
+pub use build::{BYTES_PER_PIXEL, DEFAULT_MATERIAL, RenderScene, camera_of, human_bytes};
 pub use checkpoint::{CHECKPOINT_MAGIC, CHECKPOINT_VERSION, Checkpoint, scene_fingerprint};
 pub use error::RenderError;
 pub use film::{Film, Filter, Image, PixelRect, PixelSums, TileBuffer};

@@ -1,0 +1,409 @@
+"""Tests of the obscura Python package (pytest).
+
+Round trips through the bindings for the camera models, values checked against formulas
+written out here (never against the bindings themselves), renders compared bit for bit across
+thread counts and, when OBSCURA_BIN names the `obscura` binary, with the EXR it writes; and bad
+input of every kind raising a Python exception.
+"""
+
+import math
+import os
+import pathlib
+import subprocess
+import threading
+import _thread
+
+import numpy as np
+import pytest
+
+import obscura
+
+ROOT = pathlib.Path(__file__).resolve().parents[3]
+SCENES = ROOT / "scenes"
+
+
+def scene_text(camera, resolution=(64, 48), extra=""):
+    """A minimal scene file: a film, a camera and one quad (the parser needs no more)."""
+    return f"""
+[film]
+resolution = [{resolution[0]}, {resolution[1]}]
+[camera]
+{camera}
+{extra}
+[[shapes]]
+type = "quad"
+origin = [-10.0, -10.0, -5.0]
+edge_u = [20.0, 0.0, 0.0]
+edge_v = [0.0, 20.0, 0.0]
+"""
+
+
+LOOK = "eye = [0.5, 1.0, 3.0]\ntarget = [0.0, 0.2, -1.0]"
+
+# Every model with a one-to-one film <-> direction map (ODS pairs two eyes per panorama).
+MODELS = {
+    "perspective": f'type = "perspective"\nfov = 50.0\n{LOOK}',
+    "orthographic": f'type = "orthographic"\nscreen_window = [-2.0, 2.0, -1.5, 1.5]\n{LOOK}',
+    "fisheye": f'type = "fisheye"\nprojection = "equisolid"\nfov = 185.0\n{LOOK}',
+    "environment": f'type = "environment"\n{LOOK}',
+    "cylindrical": f'type = "cylindrical"\nfov = 100.0\n{LOOK}',
+    "octahedral": f'type = "octahedral"\n{LOOK}',
+    "opencv": (
+        'type = "opencv"\nfx = 60.0\nfy = 62.0\ncx = 31.5\ncy = 23.5\n'
+        f"distortion = [-0.2, 0.05, 0.001, -0.002, 0.01]\n{LOOK}"
+    ),
+    "opencv_fisheye": (
+        'type = "opencv_fisheye"\nfx = 20.0\nfy = 20.0\ncx = 31.5\ncy = 23.5\n'
+        f"distortion = [0.04, -0.012, 0.003, -0.0005]\n{LOOK}"
+    ),
+}
+
+
+def film_points(cam, n, seed, margin=1.0):
+    """Raster positions spread over the film, `margin` pixels inside its edges."""
+    w, h = cam.resolution
+    rng = np.random.default_rng(seed)
+    return np.column_stack(
+        [rng.uniform(margin, w - margin, n), rng.uniform(margin, h - margin, n)]
+    ).astype(np.float32)
+
+
+@pytest.mark.parametrize("model", sorted(MODELS))
+def test_project_inverts_generate_rays(model):
+    square = model == "octahedral"  # an octahedral map needs a square film
+    cam = obscura.Camera.from_toml(scene_text(MODELS[model], resolution=(48, 48) if square else (64, 48)))
+    assert cam.model == model
+    xy = film_points(cam, 2000, seed=len(model))
+    o, d, valid = cam.generate_rays(xy)
+    assert o.shape == (2000, 3) and d.shape == (2000, 3) and valid.shape == (2000,)
+    assert o.dtype == np.float32 and d.dtype == np.float32 and valid.dtype == np.bool_
+    # The fisheyes have no rays outside their image circle; everything else covers the film.
+    assert valid.mean() > (0.5 if "fisheye" in model else 0.999)
+    np.testing.assert_allclose(np.linalg.norm(d[valid], axis=1), 1.0, atol=1e-5)
+    assert np.isnan(o[~valid]).all() and np.isnan(d[~valid]).all()
+    t = np.random.default_rng(7).uniform(0.5, 8.0, (2000, 1)).astype(np.float32)
+    back, seen = cam.project((o + t * d)[valid])
+    assert seen.all()
+    err = np.abs(back - xy[valid]).max()
+    assert err < 2e-2, f"{model}: round trip off by {err} px"
+
+
+def test_perspective_matches_the_pinhole_formula():
+    # fov 90 on a 2x2 film from the origin looking down -z: pixel (0, 0)'s centre (0.5, 0.5) is
+    # at screen (-0.5, 0.5), so its direction is normalize(-0.5, 0.5, -1).
+    cam = obscura.Camera.from_toml(
+        scene_text(
+            'type = "perspective"\nfov = 90.0\neye = [0.0, 0.0, 0.0]\ntarget = [0.0, 0.0, -1.0]',
+            resolution=(2, 2),
+        )
+    )
+    o, d, valid = cam.generate_rays([[0.5, 0.5], [1.0, 1.0], [2.0, 0.0]])
+    assert valid.all()
+    np.testing.assert_allclose(o, 0.0, atol=1e-7)
+    expect = np.array([[-0.5, 0.5, -1.0], [0.0, 0.0, -1.0], [1.0, 1.0, -1.0]])
+    expect /= np.linalg.norm(expect, axis=1, keepdims=True)
+    np.testing.assert_allclose(d, expect, atol=1e-6)
+
+
+def rodrigues(rvec):
+    theta = np.linalg.norm(rvec)
+    k = rvec / theta
+    kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    return np.eye(3) + math.sin(theta) * kx + (1 - math.cos(theta)) * kx @ kx
+
+
+def opencv_project(points, K, dist, rvec, tvec):
+    """cv2.projectPoints written out (k1 k2 p1 p2 k3), pixel centres at integers."""
+    k1, k2, p1, p2, k3 = dist
+    pc = points @ rodrigues(rvec).T + tvec
+    x, y = pc[:, 0] / pc[:, 2], pc[:, 1] / pc[:, 2]
+    r2 = x * x + y * y
+    radial = 1 + k1 * r2 + k2 * r2**2 + k3 * r2**3
+    xd = x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x)
+    yd = y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y
+    return np.column_stack([K[0, 0] * xd + K[0, 2], K[1, 1] * yd + K[1, 2]])
+
+
+def test_from_opencv_matches_the_opencv_formula():
+    K = np.array([[500.0, 0.0, 319.5], [0.0, 480.0, 239.5], [0.0, 0.0, 1.0]])
+    dist = np.array([-0.25, 0.08, 0.001, -0.0015, 0.01])
+    rvec = np.array([0.1, -0.2, 0.05])
+    tvec = np.array([0.3, -0.1, 2.0])
+    cam = obscura.Camera.from_opencv(K, dist, rvec.reshape(3, 1), tvec, (640, 480))
+    assert cam.model == "opencv" and cam.resolution == (640, 480)
+    rng = np.random.default_rng(3)
+    # Points in front of the camera, inside the view.
+    pc = np.column_stack(
+        [rng.uniform(-0.5, 0.5, 500), rng.uniform(-0.4, 0.4, 500), rng.uniform(1, 5, 500)]
+    )
+    R = rodrigues(rvec)
+    world = (pc - tvec) @ R  # R^T (pc - t)
+    xy, valid = cam.project(world.astype(np.float32))
+    assert valid.all()
+    expect = opencv_project(world, K, dist, rvec, tvec) + 0.5
+    np.testing.assert_allclose(xy, expect, atol=2e-3)
+    # And back: rays through those raster positions pass through the points.
+    o, d, ok = cam.generate_rays(xy)
+    assert ok.all()
+    t = np.einsum("ij,ij->i", world - o, d)[:, None]
+    np.testing.assert_allclose(o + t * d, world, atol=2e-3)
+
+
+def test_from_opencv_fisheye_round_trip():
+    K = np.array([[95.0, 0.0, 159.5], [0.0, 95.0, 159.5], [0.0, 0.0, 1.0]])
+    D = [0.04, -0.012, 0.003, -0.0005]
+    cam = obscura.Camera.from_opencv_fisheye(K, D, np.zeros(3), np.zeros(3), (320, 320))
+    assert cam.model == "opencv_fisheye"
+    # The optical axis: OpenCV's principal point is raster (cx + 0.5, cy + 0.5), along +z of
+    # the OpenCV camera, which with zero extrinsics is world +z.
+    o, d, ok = cam.generate_rays([[160.0, 160.0]])
+    assert ok.all()
+    np.testing.assert_allclose(d, [[0.0, 0.0, 1.0]], atol=1e-6)
+    xy = film_points(cam, 1000, seed=1, margin=40)
+    o, d, ok = cam.generate_rays(xy)
+    assert ok.mean() > 0.9
+    back, seen = cam.project((o + 3.0 * d)[ok])
+    assert seen.all()
+    assert np.abs(back - xy[ok]).max() < 1e-2
+
+
+def test_generate_rays_lens_and_time():
+    text = scene_text(
+        'type = "perspective"\nfov = 40.0\nlens_radius = 0.2\nfocal_distance = 4.0\n'
+        "eye = [0.0, 0.0, 0.0]\ntarget = [0.0, 0.0, -1.0]\nshutter = [0.0, 2.0]\n"
+        "eye_end = [1.0, 0.0, 0.0]\ntarget_end = [1.0, 0.0, -1.0]"
+    )
+    cam = obscura.Camera.from_toml(text)
+    assert cam.shutter == (0.0, 2.0)
+    xy = np.array([[32.0, 24.0]] * 3, dtype=np.float32)
+    lens = np.array([[0.5, 0.5], [0.9, 0.5], [0.5, 0.5]], dtype=np.float32)
+    o, d, ok = cam.generate_rays(xy, lens_uv=lens, time=np.array([0.0, 0.0, 0.5]))
+    assert ok.all()
+    # Lens centre at shutter open: the eye. Off-centre lens: another origin, the same point in
+    # focus 4 units ahead. Half-way through the shutter: the eye has moved half-way.
+    np.testing.assert_allclose(o[0], [0.0, 0.0, 0.0], atol=1e-6)
+    assert np.linalg.norm(o[1] - o[0]) > 0.05
+    focus0 = o[0] + d[0] * (4.0 / -d[0][2])
+    focus1 = o[1] + d[1] * (4.0 / -d[1][2])
+    np.testing.assert_allclose(focus0, focus1, atol=1e-4)
+    np.testing.assert_allclose(o[2], [0.5, 0.0, 0.0], atol=1e-5)
+    # A scalar time applies to every ray.
+    o2, _, _ = cam.generate_rays(xy, time=0.5)
+    np.testing.assert_allclose(o2[:, 0], 0.5, atol=1e-5)
+
+
+def test_pixel_rays_cover_the_film_in_order():
+    cam = obscura.Camera.from_toml(scene_text(MODELS["perspective"], resolution=(8, 6)))
+    o, d, ok = cam.pixel_rays(spp=4, seed=5)
+    assert o.shape == (8 * 6 * 4, 3) and ok.all()
+    # Ray i is sample i % 4 of pixel ((i // 4) % 8, i // 32): each projects inside its pixel.
+    xy, seen = cam.project(o + 2.0 * d)
+    assert seen.all()
+    i = np.arange(len(xy))
+    px, py = (i // 4) % 8, i // 32
+    assert ((xy[:, 0] >= px - 1e-3) & (xy[:, 0] <= px + 1 + 1e-3)).all()
+    assert ((xy[:, 1] >= py - 1e-3) & (xy[:, 1] <= py + 1 + 1e-3)).all()
+    # The samples of a pixel differ; the same seed repeats them, another seed does not.
+    assert len(np.unique(xy[:4], axis=0)) == 4
+    o2, d2, _ = cam.pixel_rays(spp=4, seed=5)
+    assert (d2.view(np.uint32) == d.view(np.uint32)).all()
+    _, d3, _ = cam.pixel_rays(spp=4, seed=6)
+    assert not np.array_equal(d3, d)
+
+
+def bits(a):
+    return np.ascontiguousarray(a).view(np.uint32)
+
+
+@pytest.fixture(scope="module")
+def perspective_scene():
+    return obscura.load_scene(SCENES / "spheres-perspective.toml")
+
+
+def test_render_is_the_same_for_any_thread_count(perspective_scene):
+    s = perspective_scene
+    assert s.resolution == (320, 240) and s.integrator == "path"
+    one = obscura.render(s, spp=2, threads=1)
+    two = obscura.render(s, spp=2, threads=2)
+    assert one.shape == (240, 320, 4) and one.dtype == np.float32
+    assert (bits(one) == bits(two)).all()
+    # A different seed gives a different image, so the comparison above can fail.
+    other = obscura.render(s, spp=2, seed=12345, threads=2)
+    assert not (bits(other) == bits(one)).all()
+    # Alpha: 1 where the floor or a sphere fills the pixel, 0 for the sky above the horizon.
+    assert one[-1, :, 3].min() == 1.0 and one[0, :, 3].max() == 0.0
+
+
+def test_render_accepts_a_path_and_an_aov():
+    depth = obscura.render(str(SCENES / "spheres-perspective.toml"), spp=1, integrator="depth")
+    assert depth.shape == (240, 320, 4)
+    # Camera-space depth where the pixel is covered (bottom row: the floor), 0 for the sky.
+    assert np.isfinite(depth).all()
+    assert (depth[-1, :, 0] > 0).all() and (depth[0, :, 0] == 0).all()
+
+
+OBSCURA_BIN = os.environ.get("OBSCURA_BIN")
+
+
+@pytest.mark.skipif(not OBSCURA_BIN, reason="OBSCURA_BIN names no obscura binary")
+@pytest.mark.parametrize(
+    "scene,flags",
+    [
+        ("spheres-perspective.toml", dict(spp=2, seed=3)),
+        ("spheres-thin-lens.toml", dict(spp=2, integrator="albedo")),
+        ("cornell-box.toml", dict(spp=1)),
+    ],
+)
+def test_render_equals_the_command_line(tmp_path, scene, flags):
+    out = tmp_path / "cli.exr"
+    cmd = [OBSCURA_BIN, "render", str(SCENES / scene), "-o", str(out), "--threads", "2"]
+    for k, v in flags.items():
+        cmd += [f"--{k}", str(v)]
+    subprocess.run(cmd, check=True, capture_output=True)
+    cli = obscura.read_exr(out)
+    py = obscura.render(obscura.load_scene(SCENES / scene), threads=2, **flags)
+    assert cli.shape == py.shape
+    assert (bits(cli) == bits(py)).all()
+
+
+def test_progress_callback_and_its_exception(perspective_scene):
+    calls = []
+
+    def progress(done, total):
+        calls.append((done, total))
+
+    obscura.render(perspective_scene, spp=64, progress=progress)
+    # Called from the waiting thread every 50 ms; a debug build takes long enough for several.
+    for done, total in calls:
+        assert 0 <= done <= total
+
+    class Stop(Exception):
+        pass
+
+    def stop(done, total):
+        raise Stop()
+
+    with pytest.raises(Stop):
+        obscura.render(perspective_scene, spp=100000, progress=stop)
+
+
+def test_ctrl_c_raises_keyboard_interrupt(perspective_scene):
+    # interrupt_main is what the SIGINT handler does: the render's next check of the signals
+    # raises KeyboardInterrupt and stops the workers.
+    timer = threading.Timer(0.2, _thread.interrupt_main)
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            obscura.render(perspective_scene, spp=100000, threads=1)
+    finally:
+        timer.cancel()
+
+
+# Bad input: each a Python exception with a message that says what is wrong.
+
+
+@pytest.fixture(scope="module")
+def cam():
+    return obscura.Camera.from_toml(scene_text(MODELS["perspective"]))
+
+
+def test_wrong_shapes_raise_value_error(cam):
+    with pytest.raises(ValueError, match=r"raster_xy: expected an array of shape \(N, 2\), got shape \(5, 3\)"):
+        cam.generate_rays(np.zeros((5, 3)))
+    with pytest.raises(ValueError, match=r"points: expected an array of shape \(N, 3\), got shape \(3,\)"):
+        cam.project(np.zeros(3))
+    with pytest.raises(ValueError, match="lens_uv"):
+        cam.generate_rays(np.zeros((5, 2)), lens_uv=np.zeros((4, 2)))
+    with pytest.raises(ValueError, match="time"):
+        cam.generate_rays(np.zeros((5, 2)), time=np.zeros(4))
+
+
+def test_wrong_dtypes_raise_type_error(cam):
+    with pytest.raises(TypeError, match="raster_xy: expected an array of floats or integers"):
+        cam.generate_rays(np.array([["a", "b"]]))
+    with pytest.raises(TypeError, match="points"):
+        cam.project(np.array([[object(), 1, 2]], dtype=object))
+    with pytest.raises(TypeError):
+        obscura.Camera.from_toml(42)
+
+
+def test_integers_and_float64_are_accepted(cam):
+    a, _, _ = cam.generate_rays(np.array([[10, 20]], dtype=np.int64))
+    b, _, _ = cam.generate_rays(np.array([[10.0, 20.0]], dtype=np.float64))
+    assert (bits(a) == bits(b)).all()
+
+
+def test_nans_raise_value_error(cam):
+    with pytest.raises(ValueError, match=r"raster_xy\[1\]: NaN or infinite"):
+        cam.generate_rays(np.array([[1.0, 2.0], [np.nan, 1.0]]))
+    with pytest.raises(ValueError, match=r"points\[0\]"):
+        cam.project(np.array([[np.inf, 0.0, 0.0]]))
+    with pytest.raises(ValueError, match="K"):
+        obscura.Camera.from_opencv(np.full((3, 3), np.nan), [0, 0, 0, 0], np.zeros(3), np.zeros(3), (4, 4))
+
+
+def test_bad_scene_names_file_key_and_line(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text(scene_text('type = "perspective"\nfov = 180.0\n' + LOOK))
+    with pytest.raises(ValueError) as e:
+        obscura.Camera.from_toml(bad)
+    msg = str(e.value)
+    assert str(bad) in msg and "camera.fov" in msg and ":6:" in msg
+    with pytest.raises(ValueError, match="camera.fov"):
+        obscura.load_scene(bad)
+    with pytest.raises(ValueError, match="camera.type"):
+        obscura.Camera.from_toml(scene_text('type = "pinhole"'))
+    with pytest.raises(ValueError, match="cannot read the scene file"):
+        obscura.load_scene(tmp_path / "missing.toml")
+    with pytest.raises(ValueError, match="cannot read the scene file"):
+        obscura.Camera.from_toml(str(tmp_path / "missing.toml"))
+
+
+def test_bad_opencv_arguments():
+    K = np.array([[100.0, 0.0, 50.0], [0.0, 100.0, 50.0], [0.0, 0.0, 1.0]])
+    with pytest.raises(ValueError, match="distortion"):
+        obscura.Camera.from_opencv(K, [0.1], np.zeros(3), np.zeros(3), (100, 100))
+    with pytest.raises(ValueError, match="skew"):
+        obscura.Camera.from_opencv(K + [[0, 1, 0], [0, 0, 0], [0, 0, 0]], [0] * 5, np.zeros(3), np.zeros(3), (100, 100))
+    with pytest.raises(ValueError, match="rvec: expected 3 values"):
+        obscura.Camera.from_opencv(K, [0] * 5, np.zeros(2), np.zeros(3), (100, 100))
+    with pytest.raises(ValueError, match="fx"):
+        obscura.Camera.from_opencv(K * [[-1], [1], [1]], [0] * 5, np.zeros(3), np.zeros(3), (100, 100))
+
+
+def test_bad_render_arguments(perspective_scene):
+    with pytest.raises(ValueError, match="unknown integrator `mist`"):
+        obscura.render(perspective_scene, integrator="mist")
+    with pytest.raises(ValueError, match="spp: must be >= 1"):
+        obscura.render(perspective_scene, spp=0)
+    with pytest.raises(ValueError, match="threads: must be >= 1"):
+        obscura.render(perspective_scene, threads=0)
+    with pytest.raises(TypeError, match="scene"):
+        obscura.render(3.5)
+    with pytest.raises(ValueError, match="spp"):
+        obscura.Camera.from_toml(scene_text(MODELS["perspective"])).pixel_rays(spp=0)
+
+
+@pytest.mark.parametrize("fisheye", [False, True])
+def test_project_equals_opencv_project_points(fisheye):
+    """OpenCV's own projectPoints (when cv2 is installed, as .ci/run does) against project."""
+    cv2 = pytest.importorskip("cv2")
+    K = np.array([[420.0, 0.0, 321.0], [0.0, 410.0, 238.0], [0.0, 0.0, 1.0]])
+    rvec = np.array([[0.2], [-0.1], [0.05]])
+    tvec = np.array([[0.1], [0.2], [1.5]])
+    rng = np.random.default_rng(11)
+    pc = np.column_stack(
+        [rng.uniform(-0.6, 0.6, 400), rng.uniform(-0.5, 0.5, 400), rng.uniform(1, 6, 400)]
+    )
+    world = (pc - tvec.ravel()) @ rodrigues(rvec.ravel())
+    if fisheye:
+        D = np.array([0.05, -0.01, 0.002, -0.0003])
+        cam = obscura.Camera.from_opencv_fisheye(K, D, rvec, tvec, (640, 480))
+        expect, _ = cv2.fisheye.projectPoints(world.reshape(-1, 1, 3), rvec, tvec, K, D)
+    else:
+        D = np.array([-0.28, 0.09, 0.0012, -0.0007, -0.01])
+        cam = obscura.Camera.from_opencv(K, D, rvec, tvec, (640, 480))
+        expect, _ = cv2.projectPoints(world, rvec, tvec, K, D)
+    xy, ok = cam.project(world.astype(np.float32))
+    assert ok.all()
+    np.testing.assert_allclose(xy, expect.reshape(-1, 2) + 0.5, atol=2e-3)
