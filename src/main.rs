@@ -15,6 +15,9 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
+/// The most worker threads per core `--threads` gets.
+const MAX_THREADS_PER_CORE: usize = 4;
+
 /// Exit status after a second interrupt, which quits at once without writing.
 const EXIT_SECOND_SIGNAL: i32 = 130;
 
@@ -166,9 +169,17 @@ fn run_render(args: RenderArgs) -> Result<ExitCode, RenderError> {
             ),
         ));
     }
-    let threads = args.threads;
+    let mut threads = args.threads;
     if threads == Some(0) {
         return Err(setting("--threads", "must be >= 1, got 0"));
+    }
+    // More workers than a few per core only cost time to start (10000 took 20 s for a 1-spp
+    // render); the image is the same for any count, so cap and say so.
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    if let Some(n) = threads.filter(|&n| n > MAX_THREADS_PER_CORE * cores) {
+        let cap = MAX_THREADS_PER_CORE * cores;
+        eprintln!("note: --threads {n} capped at {cap} ({MAX_THREADS_PER_CORE} per core)");
+        threads = Some(cap);
     }
     if !(args.checkpoint_every.is_finite() && args.checkpoint_every >= 0.0) {
         return Err(setting(
