@@ -406,8 +406,8 @@ impl PoseFrame {
     }
 }
 
-/// True when a world-space length that should be 1 is 1 up to f32 rounding: the test
-/// [`to_world`] uses to keep a rigid pose's clip range exactly `[near, far]`.
+/// True when a world-space length that should be 1 is 1 up to f32 rounding: the test that
+/// keeps a rigid pose's clip range exactly `[near, far]` (the models' caches, `chain::to_world`).
 #[inline]
 pub(crate) fn is_unit_length(length: f32) -> bool {
     (length - 1.0).abs() <= 1e-5

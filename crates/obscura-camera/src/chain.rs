@@ -8,7 +8,10 @@
 //! as a distance along the unit direction (the environment camera's rule) or a model-given
 //! range -> world space through the pose at that time, direction renormalised.
 
-use crate::camera::{CameraBase, CameraRay, CameraRayDifferential, CameraSample};
+use crate::camera::{
+    CameraBase, CameraRay, CameraRayDifferential, CameraSample, differential, is_unit_length,
+    ray_time,
+};
 use glam::DVec3;
 use obscura_space::{
     Camera as CameraSpace, Point2, Point3, Raster, Ray, Transform, Vector3, World,
@@ -84,16 +87,6 @@ impl PoseCache {
     }
 }
 
-/// True when every number of the sample is finite.
-#[inline]
-fn sample_is_finite(sample: &CameraSample) -> bool {
-    sample.p_film.x.is_finite()
-        && sample.p_film.y.is_finite()
-        && sample.p_lens.x.is_finite()
-        && sample.p_lens.y.is_finite()
-        && sample.time.is_finite()
-}
-
 /// Moves a camera-space ray to world space: the pose applied, the direction renormalised, and
 /// the range rescaled when the pose stretches lengths (so it keeps the same points).
 #[inline]
@@ -108,7 +101,7 @@ fn to_world(pose: &Transform<World, CameraSpace>, parts: CameraRayParts, time: f
     let length = ray.direction.length();
     let direction = ray.direction / length;
     // A rigid pose (a look-at) changes lengths only by rounding.
-    if (length - 1.0).abs() <= 1e-5 {
+    if is_unit_length(length) {
         return Ray { direction, ..ray };
     }
     Ray {
@@ -128,12 +121,8 @@ pub(crate) fn generate(
     sample: &CameraSample,
     ray_at: impl Fn(Point2<Raster>) -> Option<CameraRayParts>,
 ) -> Option<CameraRay> {
-    // The sample must be finite.
-    if !sample_is_finite(sample) {
-        return None;
-    }
-    // Time on the shutter.
-    let time = base.shutter.time_at(sample.time);
+    // A finite sample, and its time on the shutter.
+    let time = ray_time(base.shutter, sample)?;
     // The model's camera-space ray (None: no ray leaves this film point), clip range included.
     let parts = ray_at(sample.p_film)?;
     // World space through the pose at that time.
@@ -153,12 +142,8 @@ pub(crate) fn generate_differential(
     sample: &CameraSample,
     ray_at: impl Fn(Point2<Raster>) -> Option<CameraRayParts>,
 ) -> Option<CameraRayDifferential> {
-    // The sample must be finite.
-    if !sample_is_finite(sample) {
-        return None;
-    }
-    // Time on the shutter.
-    let time = base.shutter.time_at(sample.time);
+    // A finite sample, and its time on the shutter.
+    let time = ray_time(base.shutter, sample)?;
     // The main camera-space ray and the two neighbours.
     let p = sample.p_film;
     let main = ray_at(p)?;
@@ -178,17 +163,11 @@ pub(crate) fn generate_differential(
     let (rx, ry) = (neighbour(1.0, 0.0), neighbour(0.0, 1.0));
     // World space through one pose at that time.
     let world_from_camera = pose.world_from_camera(base, time);
-    let ray = to_world(&world_from_camera, main, time);
-    let rx = to_world(&world_from_camera, rx, time);
-    let ry = to_world(&world_from_camera, ry, time);
-    Some(CameraRayDifferential {
-        ray,
-        rx_origin: rx.origin,
-        rx_direction: rx.direction,
-        ry_origin: ry.origin,
-        ry_direction: ry.direction,
-        weight: 1.0,
-    })
+    Some(differential(
+        to_world(&world_from_camera, main, time),
+        to_world(&world_from_camera, rx, time),
+        to_world(&world_from_camera, ry, time),
+    ))
 }
 
 /// The camera-space position of world point `p` at `time`, in f64.
