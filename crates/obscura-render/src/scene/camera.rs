@@ -276,6 +276,7 @@ impl Cx<'_> {
                 let interaxial = raw.interaxial.unwrap_or(DEFAULT_INTERAXIAL);
                 let convergence = match (raw.convergence, kind) {
                     (Some(c), _) => c,
+                    // The ODS camera reads only the interaxial; any valid convergence will do.
                     (None, CameraKind::Ods) => 1.0,
                     (None, _) => {
                         return Err(self.err(
