@@ -4,6 +4,7 @@
 mod cli;
 mod gallery;
 mod opencv;
+mod py_fixture;
 mod robust;
 mod scenes;
 mod views;

@@ -15,14 +15,18 @@
 //! crash of the interpreter.
 #![deny(missing_docs)]
 
-use numpy::{IntoPyArray, PyArrayMethods, PyReadonlyArrayDyn};
+use numpy::{
+    IntoPyArray, PyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2, PyReadonlyArrayDyn,
+    PyUntypedArrayMethods,
+};
+use obscura_camera::CubeFace;
 use obscura_camera::{
     AnyCamera, Camera, CameraBase, CameraError, CameraSample, FilmGeometry, OpenCvCamera,
     OpenCvFisheyeCamera, OpenCvIntrinsics, Shutter, opencv_pose,
 };
 use obscura_render::{
-    IntegratorKind, RenderError, RenderOptions, RenderScene, SceneDescription, camera_of,
-    load_description, parse_description, read_exr,
+    CameraKind, IntegratorKind, RenderError, RenderOptions, RenderScene, SceneDescription,
+    camera_of, compose_stereo, load_description, parse_description, read_exr,
 };
 use obscura_sample::{Sampler, SamplerKind};
 use obscura_space::{Point2, Point3};
@@ -31,7 +35,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Mutex, mpsc};
 use std::time::Duration;
 
@@ -121,27 +125,6 @@ fn f64_values(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<(Vec<f64>, Vec<usi
     Ok((values, shape))
 }
 
-/// `(N, C)` rows of finite f32 values; ValueError naming the argument for another shape or a
-/// NaN/infinity.
-fn rows<const C: usize>(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<[f32; C]>> {
-    let arr = numeric_array(obj, name, "float32")?;
-    let shape = shape_of(&arr)?;
-    if shape.len() != 2 || shape[1] != C {
-        return Err(PyValueError::new_err(format!(
-            "{name}: expected an array of shape (N, {C}), got shape {}",
-            shape_str(&shape)
-        )));
-    }
-    // One pass from numpy's buffer (C-contiguous after numeric_array) to rows.
-    let ro: PyReadonlyArrayDyn<'_, f32> = arr.extract()?;
-    let slice = ro.as_slice()?;
-    check_finite(slice, name, C)?;
-    Ok(slice
-        .chunks_exact(C)
-        .map(|c| std::array::from_fn(|k| c[k]))
-        .collect())
-}
-
 /// ValueError naming the first row with a NaN or infinite value.
 fn check_finite<T: Into<f64> + Copy>(values: &[T], name: &str, columns: usize) -> PyResult<()> {
     match values.iter().position(|v| !(*v).into().is_finite()) {
@@ -183,22 +166,18 @@ fn vector(obj: &Bound<'_, PyAny>, name: &str, n: Option<usize>) -> PyResult<Vec<
     Ok(values)
 }
 
-/// An (N, C) float32 numpy array from `N * C` values.
-fn array2<'py>(py: Python<'py>, values: Vec<f32>, columns: usize) -> PyResult<Bound<'py, PyAny>> {
-    let n = values.len() / columns;
-    Ok(values.into_pyarray(py).reshape([n, columns])?.into_any())
-}
-
-/// Fills `origins`, `directions` and `valid` with the rays of `samples`, in parallel; a sample
-/// with no ray gets NaN origin and direction and `valid = false`.
-fn trace_samples(
+/// Writes the ray of every sample into `origins`, `directions` (3 values per ray) and `valid`,
+/// in parallel. Every element is written (NaN and `false` where no ray leaves), so reused `out=`
+/// arrays hold nothing of an earlier call. `sample(i)` returns `None` for a sample whose input
+/// is not finite; the smallest such index is returned and the caller raises for it.
+fn fill_rays(
     camera: &AnyCamera,
-    n: usize,
-    sample: impl Fn(usize) -> CameraSample + Sync,
-) -> (Vec<f32>, Vec<f32>, Vec<bool>) {
-    let mut origins = vec![f32::NAN; 3 * n];
-    let mut directions = vec![f32::NAN; 3 * n];
-    let mut valid = vec![false; n];
+    sample: impl Fn(usize) -> Option<CameraSample> + Sync,
+    origins: &mut [f32],
+    directions: &mut [f32],
+    valid: &mut [bool],
+) -> Option<usize> {
+    let bad = AtomicUsize::new(usize::MAX);
     origins
         .par_chunks_mut(3 * CHUNK)
         .zip(directions.par_chunks_mut(3 * CHUNK))
@@ -206,16 +185,165 @@ fn trace_samples(
         .enumerate()
         .for_each(|(chunk, ((o, d), v))| {
             for k in 0..v.len() {
-                let Some(r) = camera.generate_ray(&sample(chunk * CHUNK + k)) else {
-                    continue;
+                let i = chunk * CHUNK + k;
+                let ray = match sample(i) {
+                    Some(s) => camera.generate_ray(&s),
+                    None => {
+                        bad.fetch_min(i, Ordering::Relaxed);
+                        None
+                    }
                 };
-                let (p, dir) = (r.ray.origin, r.ray.direction);
-                o[3 * k..3 * k + 3].copy_from_slice(&[p.x, p.y, p.z]);
-                d[3 * k..3 * k + 3].copy_from_slice(&[dir.x, dir.y, dir.z]);
-                v[k] = true;
+                let (po, pd) = match ray {
+                    Some(r) => {
+                        let (p, dir) = (r.ray.origin, r.ray.direction);
+                        ([p.x, p.y, p.z], [dir.x, dir.y, dir.z])
+                    }
+                    None => ([f32::NAN; 3], [f32::NAN; 3]),
+                };
+                o[3 * k..3 * k + 3].copy_from_slice(&po);
+                d[3 * k..3 * k + 3].copy_from_slice(&pd);
+                v[k] = ray.is_some();
             }
         });
-    (origins, directions, valid)
+    match bad.into_inner() {
+        usize::MAX => None,
+        i => Some(i),
+    }
+}
+
+/// The `out=` tuple of a call: exactly `names.len()` items, or a TypeError/ValueError.
+fn out_tuple<'py>(out: &Bound<'py, PyAny>, names: &[&str]) -> PyResult<Vec<Bound<'py, PyAny>>> {
+    let list = names.join(", ");
+    let tuple = out.downcast::<PyTuple>().map_err(|_| {
+        PyTypeError::new_err(format!("out: expected a tuple ({list}) of numpy arrays"))
+    })?;
+    if tuple.len() != names.len() {
+        return Err(PyValueError::new_err(format!(
+            "out: expected {} arrays ({list}), got {}",
+            names.len(),
+            tuple.len()
+        )));
+    }
+    Ok(tuple.iter().collect())
+}
+
+/// One `out=` array after checking its dtype, shape, layout and writability.
+fn out_array<'py, T: numpy::Element, D: numpy::ndarray::Dimension>(
+    item: Bound<'py, PyAny>,
+    name: &str,
+    shape: &[usize],
+    dtype: &str,
+) -> PyResult<Bound<'py, PyArray<T, D>>> {
+    let want = shape_str(shape);
+    let arr = item.downcast_into::<PyArray<T, D>>().map_err(|e| {
+        PyTypeError::new_err(format!(
+            "out: {name} must be a C-contiguous {dtype} numpy array of shape {want}, got {}",
+            e.into_inner().get_type()
+        ))
+    })?;
+    if arr.shape() != shape {
+        return Err(PyValueError::new_err(format!(
+            "out: {name} must have shape {want}, got {}",
+            shape_str(arr.shape())
+        )));
+    }
+    if !arr.is_c_contiguous() {
+        return Err(PyValueError::new_err(format!(
+            "out: {name} must be C-contiguous"
+        )));
+    }
+    Ok(arr)
+}
+
+/// Write access to an output array; ValueError when it is read-only or already borrowed (the
+/// same array given twice in `out=`).
+fn writable<'py, T: numpy::Element, D: numpy::ndarray::Dimension>(
+    arr: &Bound<'py, PyArray<T, D>>,
+    name: &str,
+) -> PyResult<numpy::PyReadwriteArray<'py, T, D>> {
+    arr.try_readwrite().map_err(|e| {
+        PyValueError::new_err(format!(
+            "out: {name} cannot be written ({e}: read-only, or the same array given twice)"
+        ))
+    })
+}
+
+/// The (origins, directions, valid) arrays of a batch of `n` rays: the caller's `out=` arrays,
+/// checked, or fresh zeroed ones (numpy's calloc, so pages are first touched by the parallel
+/// fill).
+type RayArrays<'py> = (
+    Bound<'py, PyArray2<f32>>,
+    Bound<'py, PyArray2<f32>>,
+    Bound<'py, PyArray1<bool>>,
+);
+
+fn ray_arrays<'py>(
+    py: Python<'py>,
+    out: Option<&Bound<'py, PyAny>>,
+    n: usize,
+) -> PyResult<RayArrays<'py>> {
+    let Some(out) = out else {
+        return Ok((
+            PyArray2::zeros(py, [n, 3], false),
+            PyArray2::zeros(py, [n, 3], false),
+            PyArray1::zeros(py, n, false),
+        ));
+    };
+    let [o, d, v]: [Bound<'py, PyAny>; 3] = out_tuple(out, &["origins", "directions", "valid"])?
+        .try_into()
+        .map_err(|_| PyValueError::new_err("out: expected 3 arrays"))?;
+    Ok((
+        out_array(o, "origins", &[n, 3], "float32")?,
+        out_array(d, "directions", &[n, 3], "float32")?,
+        out_array(v, "valid", &[n], "bool")?,
+    ))
+}
+
+/// The (raster_xy, valid) arrays of `project`.
+type ProjectArrays<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray1<bool>>);
+
+/// The (raster_xy, valid) arrays of `project` for `n` points, as [`ray_arrays`] makes them.
+fn project_arrays<'py>(
+    py: Python<'py>,
+    out: Option<&Bound<'py, PyAny>>,
+    n: usize,
+) -> PyResult<ProjectArrays<'py>> {
+    let Some(out) = out else {
+        return Ok((
+            PyArray2::zeros(py, [n, 2], false),
+            PyArray1::zeros(py, n, false),
+        ));
+    };
+    let [xy, v]: [Bound<'py, PyAny>; 2] = out_tuple(out, &["raster_xy", "valid"])?
+        .try_into()
+        .map_err(|_| PyValueError::new_err("out: expected 2 arrays"))?;
+    Ok((
+        out_array(xy, "raster_xy", &[n, 2], "float32")?,
+        out_array(v, "valid", &[n], "bool")?,
+    ))
+}
+
+/// A read-only view of `obj` as `(N, C)` float32 values (converted only when its dtype or
+/// layout differ); the caller checks finiteness as it reads.
+fn rows_view<'py, const C: usize>(
+    obj: &Bound<'py, PyAny>,
+    name: &str,
+) -> PyResult<PyReadonlyArray2<'py, f32>> {
+    let arr = numeric_array(obj, name, "float32")?;
+    let shape = shape_of(&arr)?;
+    if shape.len() != 2 || shape[1] != C {
+        return Err(PyValueError::new_err(format!(
+            "{name}: expected an array of shape (N, {C}), got shape {}",
+            shape_str(&shape)
+        )));
+    }
+    arr.extract()
+}
+
+fn not_finite(name: &str, row: usize) -> PyErr {
+    PyValueError::new_err(format!(
+        "{name}[{row}]: NaN or infinite values are not allowed"
+    ))
 }
 
 /// A camera model of Obscura (any model of the scene format).
@@ -416,87 +544,134 @@ impl PyCamera {
     /// (N, 3), unit directions (N, 3) and a bool mask (N,): false where no ray leaves that film
     /// point (past a fisheye's image circle, say), with NaN origin and direction there.
     /// Runs in parallel with the GIL released.
-    #[pyo3(signature = (raster_xy, lens_uv=None, time=None))]
+    #[pyo3(signature = (raster_xy, lens_uv=None, time=None, out=None))]
     fn generate_rays<'py>(
         &self,
         py: Python<'py>,
         raster_xy: &Bound<'py, PyAny>,
         lens_uv: Option<&Bound<'py, PyAny>>,
         time: Option<&Bound<'py, PyAny>>,
+        out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyTuple>> {
-        let film = rows::<2>(raster_xy, "raster_xy")?;
-        let n = film.len();
-        let lens = match lens_uv {
+        let film_view = rows_view::<2>(raster_xy, "raster_xy")?;
+        let film = film_view.as_slice()?;
+        let n = film.len() / 2;
+        let lens_view = match lens_uv {
             Some(l) => {
-                let l = rows::<2>(l, "lens_uv")?;
-                if l.len() != n {
+                let l = rows_view::<2>(l, "lens_uv")?;
+                if l.shape()[0] != n {
                     return Err(PyValueError::new_err(format!(
                         "lens_uv: expected shape ({n}, 2) like raster_xy, got ({}, 2)",
-                        l.len()
+                        l.shape()[0]
                     )));
                 }
                 Some(l)
             }
             None => None,
         };
+        let lens = lens_view.as_ref().map(|l| l.as_slice()).transpose()?;
         let time = time.map(|t| per_ray(t, "time", n)).transpose()?;
+        let (o_arr, d_arr, v_arr) = ray_arrays(py, out, n)?;
+        let (mut o_rw, mut d_rw, mut v_rw) = (
+            writable(&o_arr, "origins")?,
+            writable(&d_arr, "directions")?,
+            writable(&v_arr, "valid")?,
+        );
+        let (o, d, v) = (
+            o_rw.as_slice_mut()?,
+            d_rw.as_slice_mut()?,
+            v_rw.as_slice_mut()?,
+        );
         let camera = &self.camera;
-        let (o, d, v) = py.allow_threads(|| {
-            trace_samples(camera, n, |i| {
-                let mut s = CameraSample::at(Point2::new(film[i][0], film[i][1]));
-                if let Some(l) = &lens {
-                    s.p_lens = glam::Vec2::from(l[i]);
-                }
-                if let Some(t) = &time {
-                    s.time = t[i];
-                }
-                s
-            })
+        let bad = py.allow_threads(|| {
+            fill_rays(
+                camera,
+                |i| {
+                    let (x, y) = (film[2 * i], film[2 * i + 1]);
+                    if !(x.is_finite() && y.is_finite()) {
+                        return None;
+                    }
+                    let mut s = CameraSample::at(Point2::new(x, y));
+                    if let Some(l) = lens {
+                        let (u, w) = (l[2 * i], l[2 * i + 1]);
+                        if !(u.is_finite() && w.is_finite()) {
+                            return None;
+                        }
+                        s.p_lens = glam::Vec2::new(u, w);
+                    }
+                    if let Some(t) = &time {
+                        s.time = t[i];
+                    }
+                    Some(s)
+                },
+                o,
+                d,
+                v,
+            )
         });
-        let out = (array2(py, o, 3)?, array2(py, d, 3)?, v.into_pyarray(py));
-        out.into_pyobject(py)
+        if let Some(i) = bad {
+            let film_ok = film[2 * i].is_finite() && film[2 * i + 1].is_finite();
+            return Err(not_finite(if film_ok { "lens_uv" } else { "raster_xy" }, i));
+        }
+        drop((o_rw, d_rw, v_rw));
+        (o_arr, d_arr, v_arr).into_pyobject(py)
     }
 
-    /// cam.project(points, time=None) -> (raster_xy, valid)
+    /// cam.project(points, time=None, out=None) -> (raster_xy, valid)
     ///
     /// The raster positions (N, 2) float32 (pixel centres at +0.5) of world points (N, 3), as
     /// seen through the lens centre at `time` (in the shutter's unit, default the shutter's
     /// opening). `valid` (N,) is false (and raster_xy NaN) where the camera cannot see the
     /// point (behind a projective camera, outside [near, far], ...); positions outside the
-    /// image are returned as they are. Runs in parallel with the GIL released.
-    #[pyo3(signature = (points, time=None))]
+    /// image are returned as they are. `out=(raster_xy, valid)` writes into (and returns) those
+    /// arrays (float32 (N, 2) and bool (N,), C-contiguous) instead of allocating new ones. Runs
+    /// in parallel with the GIL released.
+    #[pyo3(signature = (points, time=None, out=None))]
     fn project<'py>(
         &self,
         py: Python<'py>,
         points: &Bound<'py, PyAny>,
         time: Option<f32>,
+        out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyTuple>> {
-        let points = rows::<3>(points, "points")?;
+        let points_view = rows_view::<3>(points, "points")?;
+        let points = points_view.as_slice()?;
         let time = time.unwrap_or(self.camera.shutter().open);
         if !time.is_finite() {
             return Err(PyValueError::new_err("time: must be finite"));
         }
-        let n = points.len();
+        let n = points.len() / 3;
+        let (xy_arr, v_arr) = project_arrays(py, out, n)?;
+        let (mut xy_rw, mut v_rw) = (writable(&xy_arr, "raster_xy")?, writable(&v_arr, "valid")?);
+        let (xy, valid) = (xy_rw.as_slice_mut()?, v_rw.as_slice_mut()?);
         let camera = &self.camera;
-        let (xy, valid) = py.allow_threads(|| {
-            let mut xy = vec![f32::NAN; 2 * n];
-            let mut valid = vec![false; n];
+        let bad = py.allow_threads(|| {
+            let bad = AtomicUsize::new(usize::MAX);
             xy.par_chunks_mut(2 * CHUNK)
                 .zip(valid.par_chunks_mut(CHUNK))
                 .enumerate()
                 .for_each(|(chunk, (xy, v))| {
                     for k in 0..v.len() {
-                        let [x, y, z] = points[chunk * CHUNK + k];
-                        if let Some(r) = camera.project(Point3::new(x, y, z), time) {
-                            xy[2 * k] = r.x;
-                            xy[2 * k + 1] = r.y;
-                            v[k] = true;
-                        }
+                        let i = chunk * CHUNK + k;
+                        let p = &points[3 * i..3 * i + 3];
+                        let r = if p.iter().all(|c| c.is_finite()) {
+                            camera.project(Point3::new(p[0], p[1], p[2]), time)
+                        } else {
+                            bad.fetch_min(i, Ordering::Relaxed);
+                            None
+                        };
+                        let r = r.map_or([f32::NAN; 2], |r| [r.x, r.y]);
+                        xy[2 * k..2 * k + 2].copy_from_slice(&r);
+                        v[k] = !r[0].is_nan();
                     }
                 });
-            (xy, valid)
+            bad.into_inner()
         });
-        (array2(py, xy, 2)?, valid.into_pyarray(py)).into_pyobject(py)
+        if bad != usize::MAX {
+            return Err(not_finite("points", bad));
+        }
+        drop((xy_rw, v_rw));
+        (xy_arr, v_arr).into_pyobject(py)
     }
 
     /// cam.pixel_rays(spp=1, seed=0) -> (origins, directions, valid)
@@ -509,12 +684,13 @@ impl PyCamera {
     /// `i % spp` of pixel (x0 + (i // spp) % W, y0 + i // (spp * W)): row by row, samples of a
     /// pixel together; reshape to (H, W, spp, 3) for a per-pixel view. Returns float32 origins
     /// (N, 3), directions (N, 3) and the bool mask (N,) as generate_rays does.
-    #[pyo3(signature = (spp=1, seed=0))]
+    #[pyo3(signature = (spp=1, seed=0, out=None))]
     fn pixel_rays<'py>(
         &self,
         py: Python<'py>,
         spp: u32,
         seed: u64,
+        out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyTuple>> {
         let sampler = Sampler::new(self.sampler, spp, seed)
             .map_err(|e| PyValueError::new_err(format!("spp: {e}")))?;
@@ -531,17 +707,40 @@ impl PyCamera {
         let uses_time = camera.uses_time_sample() && camera.world_from_camera().is_animated();
         let spp_us = spp as usize;
         let w_us = w as usize;
-        let (o, d, v) = py.allow_threads(|| {
-            trace_samples(camera, n as usize, |i| {
-                let s = (i % spp_us) as u32;
-                let pixel = i / spp_us;
-                let x = x0 + (pixel % w_us) as u32;
-                let y = y0 + (pixel / w_us) as u32;
-                let mut stream = sampler.stream([x, y], s);
-                CameraSample::from_stream(&mut stream, [x, y], uses_lens, uses_time)
-            })
+        let (o_arr, d_arr, v_arr) = ray_arrays(py, out, n as usize)?;
+        let (mut o_rw, mut d_rw, mut v_rw) = (
+            writable(&o_arr, "origins")?,
+            writable(&d_arr, "directions")?,
+            writable(&v_arr, "valid")?,
+        );
+        let (o, d, v) = (
+            o_rw.as_slice_mut()?,
+            d_rw.as_slice_mut()?,
+            v_rw.as_slice_mut()?,
+        );
+        py.allow_threads(|| {
+            fill_rays(
+                camera,
+                |i| {
+                    let s = (i % spp_us) as u32;
+                    let pixel = i / spp_us;
+                    let x = x0 + (pixel % w_us) as u32;
+                    let y = y0 + (pixel / w_us) as u32;
+                    let mut stream = sampler.stream([x, y], s);
+                    Some(CameraSample::from_stream(
+                        &mut stream,
+                        [x, y],
+                        uses_lens,
+                        uses_time,
+                    ))
+                },
+                o,
+                d,
+                v,
+            )
         });
-        (array2(py, o, 3)?, array2(py, d, 3)?, v.into_pyarray(py)).into_pyobject(py)
+        drop((o_rw, d_rw, v_rw));
+        (o_arr, d_arr, v_arr).into_pyobject(py)
     }
 }
 
@@ -661,7 +860,8 @@ impl Progress {
     }
 }
 
-/// render(scene, spp=None, integrator=None, seed=None, threads=None, progress=False)
+/// render(scene, spp=None, integrator=None, seed=None, threads=None, progress=False,
+///        cube_map=False)
 ///
 /// Renders `scene` (a Scene, or a path to load) and returns its image as a float32 numpy array
 /// (H, W, 4): linear RGB and alpha (the fraction of the pixel whose camera rays hit geometry),
@@ -671,10 +871,16 @@ impl Progress {
 /// `threads` defaults to one per core. `progress` is False, True (a line on sys.stderr) or a
 /// callable taking (tiles_done, tiles_total), called from the calling thread. Ctrl-C stops the
 /// render and raises KeyboardInterrupt; so does an exception from the progress callable. The
-/// GIL is released while rendering. Stereo pairs and cube maps (`obscura render --cube-map`)
-/// are not composed here: a stereo scene renders its centre view.
+/// GIL is released while rendering.
+///
+/// Several views, as `obscura render` makes them: a scene with `[camera.stereo]` renders both
+/// eyes and returns them composed (layout "side_by_side": (H, 2W, 4); "anaglyph": (H, W, 4)) or,
+/// for layout "separate", a tuple (left, right). `cube_map=True` renders the six 90-degree
+/// faces from the camera's position (as `--cube-map`) and returns a dict from face name
+/// ("px", "nx", "py", "ny", "pz", "nz") to its array.
 #[pyfunction]
-#[pyo3(signature = (scene, spp=None, integrator=None, seed=None, threads=None, progress=None))]
+#[pyo3(signature = (scene, spp=None, integrator=None, seed=None, threads=None, progress=None, cube_map=false))]
+#[allow(clippy::too_many_arguments)]
 fn render<'py>(
     py: Python<'py>,
     scene: &Bound<'py, PyAny>,
@@ -683,6 +889,7 @@ fn render<'py>(
     seed: Option<u64>,
     threads: Option<usize>,
     progress: Option<&Bound<'py, PyAny>>,
+    cube_map: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
     let loaded;
     let scene: &PyScene = match scene.downcast::<PyScene>() {
@@ -725,71 +932,138 @@ fn render<'py>(
             }
         }
     };
-
-    let cancel = AtomicBool::new(false);
-    let tiles_done = AtomicU64::new(0);
-    let tiles_total = AtomicU64::new(0);
-    let on_tile = |done: u64, total: u64| {
-        tiles_done.fetch_max(done, Ordering::Relaxed);
-        tiles_total.store(total, Ordering::Relaxed);
+    let run = RenderRun {
+        scene,
+        sampler,
+        spp,
+        seed,
+        kind,
+        threads,
+        progress: &progress,
     };
-    let (outcome, interrupted) = py.allow_threads(|| {
-        let mut guard = lock(&scene.scene);
-        guard.sampler = sampler;
-        guard.description.sampler.spp = spp;
-        guard.description.sampler.seed = seed;
-        guard.description.integrator.kind = kind;
-        let rs: &RenderScene = &guard;
-        std::thread::scope(|s| {
-            let (tx, rx) = mpsc::channel();
-            let (cancel, on_tile) = (&cancel, &on_tile);
-            s.spawn(move || {
-                let options = RenderOptions {
-                    threads,
-                    cancel: Some(cancel),
-                    on_tile: Some(on_tile),
-                    ..Default::default()
-                };
-                // The receiver waits for this; if it has gone, nobody needs the image.
-                let _ = tx.send(obscura_render::render(rs, options));
-            });
-            let mut interrupted: Option<PyErr> = None;
-            loop {
-                match rx.recv_timeout(POLL) {
-                    Ok(outcome) => return (Some(outcome), interrupted),
-                    Err(mpsc::RecvTimeoutError::Timeout) => {
-                        if interrupted.is_none() {
-                            let (done, total) = (
-                                tiles_done.load(Ordering::Relaxed),
-                                tiles_total.load(Ordering::Relaxed),
-                            );
-                            if let Err(e) = Python::with_gil(|py| progress.poll(py, done, total)) {
-                                cancel.store(true, Ordering::Relaxed);
-                                interrupted = Some(e);
+
+    // The views the command line would make: cube faces, a stereo pair, or the one image.
+    let description = lock(&scene.scene).description.clone();
+    if cube_map {
+        let faces = pyo3::types::PyDict::new(py);
+        for (face, name) in CubeFace::ALL.into_iter().zip(CUBE_FACE_NAMES) {
+            let mut view = description.clone();
+            view.camera.kind = CameraKind::CubeFace;
+            view.camera.face = face;
+            view.camera.stereo = None;
+            let camera = camera_of(&view).map_err(render_err)?;
+            faces.set_item(name, image_array(py, run.view(py, Some(camera))?)?)?;
+        }
+        return Ok(faces.into_any());
+    }
+    if let (Some(eyes), Some(stereo)) = (description.stereo_eyes(), description.camera.stereo) {
+        let [left, right] = eyes.map(|d| camera_of(&d));
+        let left = run.view(py, Some(left.map_err(render_err)?))?;
+        let right = run.view(py, Some(right.map_err(render_err)?))?;
+        return match compose_stereo(&left, &right, stereo.layout) {
+            Some(image) => image_array(py, image),
+            None => (image_array(py, left)?, image_array(py, right)?)
+                .into_pyobject(py)
+                .map(|t| t.into_any()),
+        };
+    }
+    image_array(py, run.view(py, None)?)
+}
+
+/// The face names of `render(..., cube_map=True)`, in [`CubeFace::ALL`]'s order: the suffixes
+/// `obscura render --cube-map` gives its files.
+const CUBE_FACE_NAMES: [&str; 6] = ["px", "nx", "py", "ny", "pz", "nz"];
+
+/// One call of `render`: the settings every view of it shares.
+struct RenderRun<'a> {
+    scene: &'a PyScene,
+    sampler: Sampler,
+    spp: u32,
+    seed: u64,
+    kind: IntegratorKind,
+    threads: Option<usize>,
+    progress: &'a Progress,
+}
+
+impl RenderRun<'_> {
+    /// Renders one view: the scene's own camera, or `camera` in its place for this view only.
+    fn view(&self, py: Python<'_>, camera: Option<AnyCamera>) -> PyResult<obscura_render::Image> {
+        let (threads, progress) = (self.threads, self.progress);
+        let cancel = AtomicBool::new(false);
+        let tiles_done = AtomicU64::new(0);
+        let tiles_total = AtomicU64::new(0);
+        let on_tile = |done: u64, total: u64| {
+            tiles_done.fetch_max(done, Ordering::Relaxed);
+            tiles_total.store(total, Ordering::Relaxed);
+        };
+        let (outcome, interrupted) = py.allow_threads(|| {
+            let mut guard = lock(&self.scene.scene);
+            guard.sampler = self.sampler.clone();
+            guard.description.sampler.spp = self.spp;
+            guard.description.sampler.seed = self.seed;
+            guard.description.integrator.kind = self.kind;
+            let own_camera = camera.map(|c| std::mem::replace(&mut guard.camera, c));
+            let rs: &RenderScene = &guard;
+            let result = std::thread::scope(|s| {
+                let (tx, rx) = mpsc::channel();
+                let (cancel, on_tile) = (&cancel, &on_tile);
+                s.spawn(move || {
+                    let options = RenderOptions {
+                        threads,
+                        cancel: Some(cancel),
+                        on_tile: Some(on_tile),
+                        ..Default::default()
+                    };
+                    // The receiver waits for this; if it has gone, nobody needs the image.
+                    let _ = tx.send(obscura_render::render(rs, options));
+                });
+                let mut interrupted: Option<PyErr> = None;
+                loop {
+                    match rx.recv_timeout(POLL) {
+                        Ok(outcome) => return (Some(outcome), interrupted),
+                        Err(mpsc::RecvTimeoutError::Timeout) => {
+                            if interrupted.is_none() {
+                                let (done, total) = (
+                                    tiles_done.load(Ordering::Relaxed),
+                                    tiles_total.load(Ordering::Relaxed),
+                                );
+                                if let Err(e) =
+                                    Python::with_gil(|py| progress.poll(py, done, total))
+                                {
+                                    cancel.store(true, Ordering::Relaxed);
+                                    interrupted = Some(e);
+                                }
                             }
                         }
+                        // The render thread ended without an answer (it panicked); the scope
+                        // re-raises its panic, which PyO3 turns into a Python exception.
+                        Err(mpsc::RecvTimeoutError::Disconnected) => {
+                            return (None, interrupted);
+                        }
                     }
-                    // The render thread ended without an answer (it panicked); the scope
-                    // re-raises its panic, which PyO3 turns into a Python exception.
-                    Err(mpsc::RecvTimeoutError::Disconnected) => return (None, interrupted),
                 }
+            });
+            // The scene keeps its own camera for later calls.
+            if let Some(c) = own_camera {
+                guard.camera = c;
             }
-        })
-    });
-    if let Progress::Stderr = progress {
-        py.import("sys")?
-            .getattr("stderr")?
-            .call_method1("write", ("\n",))?;
+            result
+        });
+        if let Progress::Stderr = progress {
+            py.import("sys")?
+                .getattr("stderr")?
+                .call_method1("write", ("\n",))?;
+        }
+        if let Some(e) = interrupted {
+            return Err(e);
+        }
+        let outcome = outcome
+            .ok_or_else(|| PyValueError::new_err("the render stopped without an image"))?
+            .map_err(|e| {
+                PyValueError::new_err(format!("threads: cannot start the worker threads: {e}"))
+            })?;
+        Ok(outcome.film.resolve())
     }
-    if let Some(e) = interrupted {
-        return Err(e);
-    }
-    let outcome = outcome
-        .ok_or_else(|| PyValueError::new_err("the render stopped without an image"))?
-        .map_err(|e| {
-            PyValueError::new_err(format!("threads: cannot start the worker threads: {e}"))
-        })?;
-    image_array(py, outcome.film.resolve())
 }
 
 /// read_exr(path) -> numpy.ndarray

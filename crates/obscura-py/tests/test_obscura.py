@@ -6,6 +6,7 @@ thread counts and, when OBSCURA_BIN names the `obscura` binary, with the EXR it 
 input of every kind raising a Python exception.
 """
 
+import json
 import math
 import os
 import pathlib
@@ -407,3 +408,135 @@ def test_project_equals_opencv_project_points(fisheye):
     xy, ok = cam.project(world.astype(np.float32))
     assert ok.all()
     np.testing.assert_allclose(xy, expect.reshape(-1, 2) + 0.5, atol=2e-3)
+
+
+def test_out_arrays_are_filled_and_returned():
+    cam = obscura.Camera.from_toml(scene_text(MODELS["fisheye"]))
+    xy = film_points(cam, 500, seed=5, margin=0.0)
+    fresh = cam.generate_rays(xy)
+    # Outputs full of stale values: every element must be overwritten, NaN where no ray leaves.
+    out = (np.full((500, 3), 7.0, np.float32), np.full((500, 3), 7.0, np.float32), np.ones(500, bool))
+    got = cam.generate_rays(xy, out=out)
+    assert all(g is o for g, o in zip(got, out))
+    for g, f in zip(got[:2], fresh[:2]):
+        assert (bits(g) == bits(f)).all()
+    assert (got[2] == fresh[2]).all() and not fresh[2].all()  # some points lie past the circle
+    p = fresh[0][fresh[2]] + 2.0 * fresh[1][fresh[2]]
+    pout = (np.full((len(p), 2), 7.0, np.float32), np.zeros(len(p), bool))
+    got = cam.project(p, out=pout)
+    assert got[0] is pout[0] and (bits(got[0]) == bits(cam.project(p)[0])).all()
+    r = cam.pixel_rays(spp=1, seed=2)
+    n = len(r[2])
+    rout = (np.empty((n, 3), np.float32), np.empty((n, 3), np.float32), np.empty(n, bool))
+    got = cam.pixel_rays(spp=1, seed=2, out=rout)
+    assert (bits(got[1]) == bits(r[1])).all()
+
+
+def test_bad_out_arrays_raise(cam):
+    xy = np.zeros((4, 2), np.float32) + 10.0
+    good = lambda: (np.empty((4, 3), np.float32), np.empty((4, 3), np.float32), np.empty(4, bool))
+    with pytest.raises(TypeError, match="out: expected a tuple"):
+        cam.generate_rays(xy, out=[np.empty((4, 3), np.float32)] * 3)
+    with pytest.raises(ValueError, match="out: expected 3 arrays"):
+        cam.generate_rays(xy, out=good()[:2])
+    o, d, v = good()
+    with pytest.raises(ValueError, match=r"out: origins must have shape \(4, 3\)"):
+        cam.generate_rays(xy, out=(np.empty((5, 3), np.float32), d, v))
+    with pytest.raises(TypeError, match="out: directions must be a C-contiguous float32"):
+        cam.generate_rays(xy, out=(o, np.empty((4, 3), np.float64), v))
+    with pytest.raises(ValueError, match="C-contiguous"):
+        cam.generate_rays(xy, out=(o, np.empty((3, 4), np.float32).T, v))
+    ro = np.empty((4, 3), np.float32)
+    ro.flags.writeable = False
+    with pytest.raises(ValueError, match="out: origins cannot be written"):
+        cam.generate_rays(xy, out=(ro, d, v))
+    with pytest.raises(ValueError, match="out: directions cannot be written"):
+        cam.generate_rays(xy, out=(o, o, v))
+    with pytest.raises(TypeError, match="out: valid must be a C-contiguous bool"):
+        cam.project(np.zeros((4, 3)), out=(np.empty((4, 2), np.float32), np.empty(4, np.uint8)))
+
+
+STEREO = """
+[camera.stereo]
+interaxial = 0.3
+convergence = 4.0
+layout = "{layout}"
+"""
+
+
+def stereo_scene(tmp_path, layout):
+    text = (SCENES / "spheres-perspective.toml").read_text()
+    assert "[camera.stereo]" not in text
+    # The [camera] table is followed by others: put the stereo sub-table at the end.
+    path = tmp_path / f"stereo-{layout}.toml"
+    path.write_text(text + STEREO.format(layout=layout))
+    return path
+
+
+@pytest.mark.parametrize("layout", ["side_by_side", "anaglyph", "separate"])
+def test_stereo_pairs_are_composed_as_their_layout_says(tmp_path, layout):
+    path = stereo_scene(tmp_path, layout)
+    mono = obscura.render(SCENES / "spheres-perspective.toml", spp=1, threads=2)
+    got = obscura.render(path, spp=1, threads=2)
+    if layout == "separate":
+        left, right = got
+        assert left.shape == right.shape == mono.shape
+        assert not (bits(left) == bits(right)).all()
+    elif layout == "side_by_side":
+        assert got.shape == (240, 640, 4)
+        assert not (bits(got[:, :320]) == bits(got[:, 320:])).all()
+    else:
+        assert got.shape == mono.shape
+    if OBSCURA_BIN:
+        out = tmp_path / "cli.exr"
+        cmd = [OBSCURA_BIN, "render", str(path), "-o", str(out), "--spp", "1"]
+        subprocess.run(cmd, check=True, capture_output=True)
+        if layout == "separate":
+            for eye, img in zip(["left", "right"], got):
+                cli = obscura.read_exr(tmp_path / f"cli-{eye}.exr")
+                assert (bits(cli) == bits(img)).all()
+        else:
+            assert (bits(obscura.read_exr(out)) == bits(got)).all()
+
+
+def test_cube_map_faces_equal_the_command_line(tmp_path):
+    path = tmp_path / "cube.toml"
+    text = (SCENES / "spheres-perspective.toml").read_text()
+    path.write_text(text.replace("resolution = [320, 240]", "resolution = [32, 32]"))
+    faces = obscura.render(path, spp=1, cube_map=True)
+    assert sorted(faces) == sorted(["px", "nx", "py", "ny", "pz", "nz"])
+    assert all(f.shape == (32, 32, 4) for f in faces.values())
+    # Up (+y) sees the sky only, down (-y) the floor only: alpha 0 and 1.
+    assert faces["py"][..., 3].max() == 0.0 and faces["ny"][..., 3].min() == 1.0
+    if OBSCURA_BIN:
+        out = tmp_path / "cli.exr"
+        cmd = [OBSCURA_BIN, "render", str(path), "-o", str(out), "--spp", "1", "--cube-map"]
+        subprocess.run(cmd, check=True, capture_output=True)
+        for name, img in faces.items():
+            assert (bits(obscura.read_exr(tmp_path / f"cli-{name}.exr")) == bits(img)).all()
+
+
+FIXTURE = pathlib.Path(__file__).parent / "data" / "rays.json"
+
+
+def from_bits(values, columns):
+    a = np.array(values, dtype=np.uint32).view(np.float32)
+    return a.reshape(-1, columns) if columns > 1 else a
+
+
+@pytest.mark.parametrize("case", json.loads(FIXTURE.read_text())["cameras"], ids=lambda c: c["name"])
+def test_bindings_equal_the_rust_crates_bit_for_bit(case):
+    # Expected values written by the Rust crates themselves (tests/it/py_fixture.rs).
+    cam = obscura.Camera.from_toml(case["toml"])
+    o, d, valid = cam.generate_rays(
+        from_bits(case["raster_xy"], 2),
+        lens_uv=from_bits(case["lens_uv"], 2),
+        time=from_bits(case["time"], 1),
+    )
+    assert (valid == np.array(case["valid"])).all()
+    assert (bits(o) == np.array(case["origins"], np.uint32).reshape(-1, 3)).all()
+    assert (bits(d) == np.array(case["directions"], np.uint32).reshape(-1, 3)).all()
+    points = from_bits(case["points"], 3)
+    xy, seen = cam.project(points)
+    assert (seen == np.array(case["points_valid"])).all()
+    assert (bits(xy) == np.array(case["raster_of_points"], np.uint32).reshape(-1, 2)).all()

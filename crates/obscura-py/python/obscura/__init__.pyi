@@ -1,7 +1,7 @@
 """Type stubs of the obscura package (the compiled module obscura._obscura)."""
 
 import os
-from typing import Callable, Optional, Tuple, Union
+from typing import Callable, Dict, Optional, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -54,20 +54,29 @@ class Camera:
         raster_xy: _ArrayLike,
         lens_uv: Optional[_ArrayLike] = None,
         time: Optional[Union[float, _ArrayLike]] = None,
+        out: Optional[Tuple[_F32, _F32, _Bool]] = None,
     ) -> Tuple[_F32, _F32, _Bool]:
         """Rays through raster positions (N, 2) -> (origins (N, 3), directions (N, 3), valid (N,)).
 
         lens_uv (N, 2) in [0, 1)^2 (default the lens centre 0.5); time is the shutter sample u in
-        [0, 1) (a number or (N,); default 0). Where no ray leaves, valid is False and the ray NaN."""
+        [0, 1) (a number or (N,); default 0). Where no ray leaves, valid is False and the ray NaN.
+        out=(origins, directions, valid): C-contiguous float32 (N, 3), float32 (N, 3) and bool
+        (N,) arrays to write into (and return) instead of new ones; every element is written."""
     def project(
-        self, points: _ArrayLike, time: Optional[float] = None
+        self,
+        points: _ArrayLike,
+        time: Optional[float] = None,
+        out: Optional[Tuple[_F32, _Bool]] = None,
     ) -> Tuple[_F32, _Bool]:
         """World points (N, 3) -> (raster_xy (N, 2), valid (N,)); time in shutter units
-        (default the shutter's opening). Invisible points: valid False, raster NaN."""
-    def pixel_rays(self, spp: int = 1, seed: int = 0) -> Tuple[_F32, _F32, _Bool]:
+        (default the shutter's opening). Invisible points: valid False, raster NaN.
+        out=(raster_xy, valid): float32 (N, 2) and bool (N,) arrays to write into."""
+    def pixel_rays(
+        self, spp: int = 1, seed: int = 0, out: Optional[Tuple[_F32, _F32, _Bool]] = None
+    ) -> Tuple[_F32, _F32, _Bool]:
         """The renderer's camera rays for the whole film: H*W*spp rays, row by row, the samples of
         a pixel together (reshape to (H, W, spp, 3)); drawn from the scene's sampler (Sobol for
-        OpenCV cameras) with this seed."""
+        OpenCV cameras) with this seed. out= as for generate_rays."""
 
 class Scene:
     """A scene file loaded and built, ready to render."""
@@ -101,11 +110,16 @@ def render(
     seed: Optional[int] = None,
     threads: Optional[int] = None,
     progress: Union[bool, Callable[[int, int], object], None] = False,
-) -> _F32:
+    cube_map: bool = False,
+) -> Union[_F32, Tuple[_F32, _F32], Dict[str, _F32]]:
     """Render to a float32 (H, W, 4) linear RGBA array, equal bit for bit to `obscura render`.
 
     integrator: path, depth, distance, position, normal or albedo. progress: False, True (a line
-    on stderr) or a callable (tiles_done, tiles_total). Ctrl-C raises KeyboardInterrupt."""
+    on stderr) or a callable (tiles_done, tiles_total). Ctrl-C raises KeyboardInterrupt.
+    A `[camera.stereo]` scene gives both eyes composed as its layout says ("side_by_side":
+    (H, 2W, 4), "anaglyph": (H, W, 4)) or, for "separate", a tuple (left, right).
+    cube_map=True gives a dict {"px", "nx", "py", "ny", "pz", "nz"} of the six faces, as
+    `obscura render --cube-map` writes them."""
 
 def read_exr(path: _PathLike) -> _F32:
     """An RGBA EXR (as `obscura render` writes it) as float32 (H, W, 4), values exactly as stored."""
