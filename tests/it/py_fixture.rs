@@ -61,9 +61,9 @@ fn cameras() -> Vec<(&'static str, String)> {
 /// A scene file around a camera table: film, camera (with the shared look-at), one quad.
 fn scene(camera: &str) -> String {
     // The look-at goes before any sub-table of [camera] (ODS's [camera.stereo]).
-    let (own, sub) = camera.split_once("\n[").map_or((camera, String::new()), |(a, b)| {
-        (a, format!("[{b}"))
-    });
+    let (own, sub) = camera
+        .split_once("\n[")
+        .map_or((camera, String::new()), |(a, b)| (a, format!("[{b}")));
     let shutter = if own.contains("cube_face") || own.contains("ods") {
         ""
     } else {
@@ -80,7 +80,10 @@ fn samples(n: usize) -> Vec<CameraSample> {
         .map(|k| {
             let k = k as f32;
             CameraSample {
-                p_film: Point2::new((k * 0.618_034).fract() * 64.0, (k * 0.754_877_7).fract() * 64.0),
+                p_film: Point2::new(
+                    (k * 0.618_034).fract() * 64.0,
+                    (k * 0.754_877_7).fract() * 64.0,
+                ),
                 p_lens: glam::Vec2::new((k * 0.569_840_3).fract(), (k * 0.362_465_6).fract()),
                 time: (k * 0.281_323_8).fract(),
             }
@@ -170,6 +173,8 @@ fn python_fixture_matches_the_rust_crates() {
     let v = expected();
     let cams = v["cameras"].as_array().unwrap();
     assert!(cams.len() >= 15);
-    let none = cams.iter().filter(|c| c["valid"].as_array().unwrap().iter().any(|b| b == false));
+    let none = cams
+        .iter()
+        .filter(|c| c["valid"].as_array().unwrap().iter().any(|b| b == false));
     assert!(none.count() >= 1);
 }

@@ -184,26 +184,32 @@ fn fill_rays(
         .zip(valid.par_chunks_mut(CHUNK))
         .enumerate()
         .for_each(|(chunk, ((o, d), v))| {
-            for k in 0..v.len() {
-                let i = chunk * CHUNK + k;
-                let ray = match sample(i) {
+            let first = chunk * CHUNK;
+            let mut first_bad = usize::MAX;
+            let rows = o.chunks_exact_mut(3).zip(d.chunks_exact_mut(3)).zip(v);
+            for (k, ((o, d), v)) in rows.enumerate() {
+                let ray = match sample(first + k) {
                     Some(s) => camera.generate_ray(&s),
                     None => {
-                        bad.fetch_min(i, Ordering::Relaxed);
+                        first_bad = first_bad.min(first + k);
                         None
                     }
                 };
-                let (po, pd) = match ray {
+                match ray {
                     Some(r) => {
-                        let (p, dir) = (r.ray.origin, r.ray.direction);
-                        ([p.x, p.y, p.z], [dir.x, dir.y, dir.z])
+                        let (p, w) = (r.ray.origin, r.ray.direction);
+                        o.copy_from_slice(&[p.x, p.y, p.z]);
+                        d.copy_from_slice(&[w.x, w.y, w.z]);
+                        *v = true;
                     }
-                    None => ([f32::NAN; 3], [f32::NAN; 3]),
-                };
-                o[3 * k..3 * k + 3].copy_from_slice(&po);
-                d[3 * k..3 * k + 3].copy_from_slice(&pd);
-                v[k] = ray.is_some();
+                    None => {
+                        o.fill(f32::NAN);
+                        d.fill(f32::NAN);
+                        *v = false;
+                    }
+                }
             }
+            bad.fetch_min(first_bad, Ordering::Relaxed);
         });
     match bad.into_inner() {
         usize::MAX => None,

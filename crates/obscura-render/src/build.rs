@@ -327,12 +327,20 @@ pub(crate) fn build_camera(
 
 /// Reads an equirectangular EXR as linear RGB texels, row 0 at the top.
 fn read_environment_map(path: &Path) -> Result<(u32, u32, Vec<Vec3>), String> {
-    let (image, _) = crate::output::read_exr(path).map_err(|e| match e {
-        RenderError::Encode { message, .. } if !path.exists() => {
-            format!("{}: file not found ({message})", path.display())
+    let bytes = std::fs::read(path).map_err(|e| {
+        if path.exists() {
+            format!("{}: cannot read EXR: {e}", path.display())
+        } else {
+            format!("{}: file not found ({e})", path.display())
         }
-        other => other.to_string(),
     })?;
+    environment_map_texels(&bytes, path)
+}
+
+/// The texels of an equirectangular EXR's bytes (`path` names it in errors): width, height and
+/// linear RGB texels, row 0 at the top; an error for a texel that is negative, NaN or infinite.
+pub fn environment_map_texels(bytes: &[u8], path: &Path) -> Result<(u32, u32, Vec<Vec3>), String> {
+    let (image, _) = crate::output::decode_exr(bytes, path).map_err(|e| e.to_string())?;
     let texels: Vec<Vec3> = image
         .pixels
         .iter()

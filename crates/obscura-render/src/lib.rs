@@ -60,11 +60,15 @@ mod render;
 mod scene;
 mod stereo;
 
-pub use build::{BYTES_PER_PIXEL, DEFAULT_MATERIAL, RenderScene, camera_of, human_bytes};
+pub use build::{
+    BYTES_PER_PIXEL, DEFAULT_MATERIAL, RenderScene, camera_of, environment_map_texels, human_bytes,
+};
 pub use checkpoint::{CHECKPOINT_MAGIC, CHECKPOINT_VERSION, Checkpoint, scene_fingerprint};
 pub use error::RenderError;
 pub use film::{Film, Filter, Image, PixelRect, PixelSums, TileBuffer};
-pub use output::{ImageInfo, OutputFormat, read_exr, srgb_8bit, temporary_beside, write_image};
+pub use output::{
+    ImageInfo, OutputFormat, decode_exr, read_exr, srgb_8bit, temporary_beside, write_image,
+};
 pub use postprocess::{
     DepthOfField, ScreenBuffers, circle_of_confusion, circle_of_confusion_orthographic,
     depth_of_field, motion_blur, screen_buffers,

@@ -151,6 +151,15 @@ fn write_png(tmp: &Path, image: &Image) -> Result<(), RenderError> {
 /// Reads an EXR written by [`write_image`] (or any RGBA EXR) back as linear floats, with its
 /// partial flag. For tests and tools.
 pub fn read_exr(path: &Path) -> Result<(Image, bool), RenderError> {
+    let bytes = std::fs::read(path).map_err(|e| RenderError::Encode {
+        file: path.to_path_buf(),
+        message: format!("cannot read EXR: {e}"),
+    })?;
+    decode_exr(&bytes, path)
+}
+
+/// [`read_exr`] of a file's bytes; `path` names the file in errors.
+pub fn decode_exr(bytes: &[u8], path: &Path) -> Result<(Image, bool), RenderError> {
     use exr::prelude::*;
     let img = read()
         .no_deep_data()
@@ -163,7 +172,7 @@ pub fn read_exr(path: &Path) -> Result<(Image, bool), RenderError> {
         )
         .first_valid_layer()
         .all_attributes()
-        .from_file(path)
+        .from_buffered(std::io::Cursor::new(bytes))
         .map_err(|e| RenderError::Encode {
             file: path.to_path_buf(),
             message: format!("cannot read EXR: {e}"),
