@@ -7,6 +7,7 @@ mod opencv;
 mod py_fixture;
 mod robust;
 mod scenes;
+mod soak;
 mod views;
 
 use obscura_render::{

@@ -26,7 +26,7 @@ fn scene_path(name: &str) -> PathBuf {
 }
 
 /// Sends `signal` (e.g. "INT") to `child` with the system's `kill` command.
-fn send(child: &Child, signal: &str) {
+pub(super) fn send(child: &Child, signal: &str) {
     let status = Command::new("kill")
         .arg(format!("-{signal}"))
         .arg(child.id().to_string())
@@ -37,7 +37,7 @@ fn send(child: &Child, signal: &str) {
 
 /// Polls `done` every few milliseconds. The timeout only bounds a failure; it does not
 /// synchronise anything.
-fn wait_until(what: &str, mut done: impl FnMut() -> bool) {
+pub(super) fn wait_until(what: &str, mut done: impl FnMut() -> bool) {
     let start = Instant::now();
     while !done() {
         assert!(
@@ -77,7 +77,7 @@ fn start_long_render(dir: &Path, output: &Path) -> (Child, PathBuf) {
     (child, checkpoint)
 }
 
-fn names_in(dir: &Path) -> Vec<String> {
+pub(super) fn names_in(dir: &Path) -> Vec<String> {
     let mut names: Vec<String> = std::fs::read_dir(dir)
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())

@@ -1,0 +1,58 @@
+#!/usr/bin/env bash
+# The long soak test of interrupted renders (run by hand; the test suite runs a five-cycle
+# version, tests/it/soak.rs):
+#
+#   bash tests/soak.sh [CYCLES] [SCENE]        # default 100 cycles of scenes/spheres-thin-lens.toml
+#
+# Renders SCENE straight through once, then again while sending SIGINT at a random moment of
+# each run (0 to 300 ms after it starts, before or after its signal handlers are installed)
+# and resuming from the checkpoint every time, until CYCLES interrupts have landed; then lets
+# it finish. The final image must equal the straight one bit for bit and the folder must hold
+# no temporary or partial file. Exits 0 on success, 1 with a message otherwise.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cycles=${1:-100}
+scene=${2:-scenes/spheres-thin-lens.toml}
+cargo build --release --quiet
+bin=$PWD/target/release/obscura
+dir=$(mktemp -d /tmp/obscura-soak.XXXXXX)
+trap 'rm -rf "$dir"' EXIT
+# Large enough that 100 interrupts land before the end: about 40 s of rendering on 2 cores.
+flags=(--resolution 160x120 --spp 2048 --threads 2)
+
+"$bin" render "$scene" -o "$dir/straight.exr" "${flags[@]}" >/dev/null
+landed=0 runs=0 early=0
+while [ "$landed" -lt "$cycles" ]; do
+    resume=()
+    [ -f "$dir/soak.ckpt" ] && resume=(--resume "$dir/soak.ckpt")
+    "$bin" render "$scene" -o "$dir/out.exr" "${flags[@]}" \
+        --checkpoint "$dir/soak.ckpt" --checkpoint-every 0 "${resume[@]}" >/dev/null 2>"$dir/err" &
+    pid=$!
+    sleep "0.$(printf '%03d' $((RANDOM % 300)))"
+    kill -INT "$pid" 2>/dev/null || true
+    set +e
+    wait "$pid"
+    code=$?
+    set -e
+    runs=$((runs + 1))
+    case $code in
+        130) landed=$((landed + 1)) ;;
+        0) echo "the render finished after $landed interrupts; use a larger --spp" >&2; exit 1 ;;
+        # SIGINT before the handlers were installed: the default action, no checkpoint change.
+        *) if grep -q . "$dir/err"; then cat "$dir/err" >&2; echo "exit $code" >&2; exit 1; fi
+           early=$((early + 1)) ;;
+    esac
+done
+"$bin" render "$scene" -o "$dir/out.exr" "${flags[@]}" --checkpoint "$dir/soak.ckpt" \
+    --resume "$dir/soak.ckpt" >/dev/null
+rm -f "$dir/err"
+if ! cmp -s "$dir/out.exr" "$dir/straight.exr"; then
+    echo "FAIL: the resumed image differs from the straight render" >&2
+    exit 1
+fi
+left=$(ls "$dir" | grep -v -x -e out.exr -e soak.ckpt -e straight.exr || true)
+if [ -n "$left" ]; then
+    echo "FAIL: files left behind: $left" >&2
+    exit 1
+fi
+echo "soak: $landed interrupts landed in $runs runs ($early before the handlers were installed); final image equals the straight render bit for bit; no file left behind"
