@@ -89,7 +89,7 @@ impl RenderScene {
                     edge_v: (*edge_v).into(),
                 },
                 ShapeGeometry::Mesh { file: mesh_file } => {
-                    let mesh = match meshes.get(mesh_file) {
+                    let mesh = match meshes.get(mesh_file).or_else(|| d.meshes.get(mesh_file)) {
                         Some(m) => m.clone(),
                         None => {
                             let m = Arc::new(
@@ -273,9 +273,13 @@ pub(crate) fn build_camera(
     // The pose: OpenCV extrinsics, or the look-at(s), moved to one eye for a stereo pair.
     let rig = c.stereo.map(|s| s.rig);
     let eye = c.eye.zip(rig);
-    let pose = match c.extrinsics {
-        Some(x) => opencv_pose(x.rvec, x.tvec)?,
-        None => {
+    let pose = match (c.pose, c.extrinsics) {
+        (Some((start, Some(end))), _) if c.shutter.open < c.shutter.close => {
+            AnimatedTransform::new(start, c.shutter.open, end, c.shutter.close)?
+        }
+        (Some((start, _)), _) => AnimatedTransform::fixed(start),
+        (None, Some(x)) => opencv_pose(x.rvec, x.tvec)?,
+        (None, None) => {
             let for_eye = |look: LookAt| match eye {
                 Some((eye, rig)) => rig.eye_look_at(eye, look),
                 None => Ok(look),

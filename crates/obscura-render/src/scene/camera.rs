@@ -12,7 +12,7 @@ use obscura_camera::{
     CameraError, CubeFace, FisheyeProjection, FovAxis, LookAt, OpenCvIntrinsics, ScreenWindow,
     Shutter, StereoRig, ThinLens, opencv_pose, validate_clip, validate_fov,
 };
-use obscura_space::{Point3, SpaceError, Vector3};
+use obscura_space::{Camera as CameraSpace, Point3, SpaceError, Transform, Vector3, World};
 
 /// The interaxial distance when `[camera.stereo]` does not give one: 65 mm, a typical adult's
 /// distance between the pupils, in metres.
@@ -158,6 +158,29 @@ impl Cx<'_> {
             }
             (None, Some(_)) => {
                 return Err(self.err("camera.tvec", "tvec needs rvec beside it"));
+            }
+        };
+        // Or as matrices, world from camera (what an imported scene's camera transform is).
+        let pose = match (c.pose, c.pose_end) {
+            (None, None) => None,
+            (None, Some(_)) => {
+                return Err(self.err("camera.pose_end", "pose_end needs pose beside it"));
+            }
+            (Some(start), end) => {
+                if look_given || extrinsics.is_some() {
+                    return Err(self.err(
+                        "camera.pose",
+                        "give the pose one way only: a look-at (eye, target, up), OpenCV \
+                         extrinsics (rvec, tvec) or a matrix (pose)",
+                    ));
+                }
+                let matrix = |key: &str, m: [f32; 16]| {
+                    self.finite(key, &m)?;
+                    Transform::<World, CameraSpace>::from_rows(m)
+                        .map_err(|e| self.err(key, e.to_string()))
+                };
+                let end = end.map(|m| matrix("camera.pose_end", m)).transpose()?;
+                Some((matrix("camera.pose", start)?, end))
             }
         };
         let v3 = |key: &str, v: Option<V3>, default: V3| -> Result<V3, RenderError> {
@@ -334,6 +357,7 @@ impl Cx<'_> {
             lens_shift,
             stereo,
             eye: None,
+            pose,
         })
     }
 

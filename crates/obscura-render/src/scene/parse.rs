@@ -80,6 +80,7 @@ pub fn parse_description(path: &Path, source: &str) -> Result<SceneDescription, 
         shapes,
         lights,
         ignored,
+        meshes: Default::default(),
         source: source.into(),
     })
 }
