@@ -227,7 +227,7 @@ impl Imported {
             .file_stem()
             .map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned());
         let mesh_dir = format!("{stem}-meshes");
-        let out_base = out.parent().unwrap_or(Path::new(""));
+        let out_base = folder(out);
         // Paths in the text (maps, mesh folder) are relative to the TOML file: rewrite them for
         // the output's folder.
         let text = self.text_for(out_base, &mesh_dir)?;
@@ -256,7 +256,7 @@ impl Imported {
 
     /// The TOML text with its relative paths made relative to `out_base`.
     fn text_for(&self, out_base: &Path, mesh_dir: &str) -> Result<String, ImportError> {
-        let src_base = self.source.parent().unwrap_or(Path::new(""));
+        let src_base = folder(&self.source);
         let same = |a: &Path, b: &Path| {
             a == b
                 || (a.canonicalize().ok().is_some()
@@ -290,6 +290,14 @@ impl Imported {
             text = out;
         }
         Ok(text)
+    }
+}
+
+/// The folder a file is in (`.` for a bare file name).
+fn folder(file: &Path) -> &Path {
+    match file.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
     }
 }
 

@@ -1387,6 +1387,10 @@ impl Pbrt {
             }
         }
         let _ = res;
+        if self.ir.integrator.is_none() {
+            // pbrt's default integrator: volpath with maxdepth 5.
+            self.ir.integrator = Some(("path", Some(5), loc.clone()));
+        }
         p.unused(&format!("Camera \"{kind}\""), &mut self.ir.warnings);
         self.ir.camera = Some(cam);
         Ok(())
