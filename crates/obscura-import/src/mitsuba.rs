@@ -413,7 +413,7 @@ impl<'d, 'i> Mitsuba<'d, 'i> {
         let depth = match (kind.as_str(), self.float(n, "max_depth")?) {
             ("direct", _) => 1.0,
             (_, Some(d)) if d >= 1.0 => d,
-            (_, Some(d)) if d == -1.0 => {
+            (_, Some(-1.0)) => {
                 self.ir.warn(
                     &loc,
                     "max_depth -1 (unbounded): Obscura stops at 64 bounces",
@@ -823,7 +823,7 @@ impl<'d, 'i> Mitsuba<'d, 'i> {
                     None => [0.0; 3],
                 };
                 let radius = self.float(n, "radius")?.unwrap_or(1.0);
-                if !(radius > 0.0) {
+                if radius.is_nan() || radius <= 0.0 {
                     return Err(loc.error(format!(
                         "<shape type=\"sphere\">: radius must be > 0, got {radius}"
                     )));
@@ -946,7 +946,7 @@ impl<'d, 'i> Mitsuba<'d, 'i> {
                     (None, Some(m)) => m.transform_vector3(DVec3::Z),
                     (None, None) => DVec3::Z,
                 };
-                if !(d.length() > 0.0) {
+                if d.length().is_nan() || d.length() <= 0.0 {
                     return Err(loc.error("<emitter type=\"directional\">: the direction is zero"));
                 }
                 LightIr::Distant {

@@ -507,10 +507,10 @@ impl Pbrt {
                     && matches!(c.tokens.get(c.at).map(|t| &t.kind), Some(Kind::Str(_)))
                 {
                     // The optional second name (exterior); a parameter declaration has a space.
-                    if let Some(Kind::Str(s)) = c.tokens.get(c.at).map(|t| &t.kind) {
-                        if !s.contains(' ') {
-                            c.at += 1;
-                        }
+                    if let Some(Kind::Str(s)) = c.tokens.get(c.at).map(|t| &t.kind)
+                        && !s.contains(' ')
+                    {
+                        c.at += 1;
                     }
                 }
                 let _ = c.params(d)?;
@@ -824,10 +824,9 @@ impl Pbrt {
                         match eta_ty.as_deref() {
                             Some("spectrum") => {
                                 let n = p.string("eta")?.unwrap_or_default();
-                                let _ =
-                                    p.0.iter()
-                                        .filter(|q| q.name == "k")
-                                        .for_each(|q| q.used.set(true));
+                                p.0.iter()
+                                    .filter(|q| q.name == "k")
+                                    .for_each(|q| q.used.set(true));
                                 named(&n).unwrap_or_else(|| {
                                     w.push(format!("{loc}: {directive}: spectrum \"{n}\" is not known; using copper"));
                                     [0.955, 0.638, 0.538]
@@ -874,14 +873,13 @@ impl Pbrt {
                         w.push(format!(
                             "{loc}: {directive}: a spectral eta is not supported; using 1.5"
                         ));
-                        let _ =
-                            p.0.iter()
-                                .filter(|q| q.name == "eta")
-                                .for_each(|q| q.used.set(true));
+                        p.0.iter()
+                            .filter(|q| q.name == "eta")
+                            .for_each(|q| q.used.set(true));
                         1.5
                     }
                 };
-                if !(eta > 0.0) {
+                if eta.is_nan() || eta <= 0.0 {
                     return Err(loc.error(format!("{directive}: eta must be > 0, got {eta}")));
                 }
                 let rough = [
@@ -907,13 +905,8 @@ impl Pbrt {
                 MaterialIr::Diffuse([0.5; 3])
             }
         };
+        // MakeNamedMaterial's own parameter; normal and displacement maps warn as unused.
         let _ = p.string("type");
-        let _ =
-            p.0.iter()
-                .filter(|q| q.name == "normalmap" || q.name == "displacement")
-                .map(|q| {
-                    q.used.set(true);
-                });
         p.unused(&directive, &mut self.ir.warnings);
         let name = self.ir.material_name(wanted);
         self.ir.materials.push((name.clone(), m, loc.clone()));
@@ -949,7 +942,7 @@ impl Pbrt {
                 let from = DVec3::from(p.fixed::<3>("from")?.unwrap_or([0.0; 3]));
                 let to = DVec3::from(p.fixed::<3>("to")?.unwrap_or([0.0, 0.0, 1.0]));
                 let dir = ctm.transform_vector3(to - from);
-                if !(dir.length() > 0.0) || !dir.is_finite() {
+                if (dir.length().is_nan() || dir.length() <= 0.0) || !dir.is_finite() {
                     return Err(loc.error("LightSource \"distant\": from and to coincide"));
                 }
                 LightIr::Distant {
@@ -989,7 +982,7 @@ impl Pbrt {
         let geometry = match kind {
             "sphere" => {
                 let radius = p.num_or("radius", 1.0)?;
-                if !(radius > 0.0) {
+                if radius.is_nan() || radius <= 0.0 {
                     return Err(loc.error(format!("{directive}: radius must be > 0, got {radius}")));
                 }
                 let partial = p.num("zmin")?.is_some_and(|z| z > -radius)
@@ -1015,10 +1008,9 @@ impl Pbrt {
                             loc.error(format!("{directive}: needs \"string filename\""))
                         })?;
                         if p.type_of("displacement").is_some() {
-                            let _ =
-                                p.0.iter()
-                                    .filter(|q| q.name == "displacement" || q.name == "edgelength")
-                                    .for_each(|q| q.used.set(true));
+                            p.0.iter()
+                                .filter(|q| q.name == "displacement" || q.name == "edgelength")
+                                .for_each(|q| q.used.set(true));
                             self.ir.warn(
                                 loc,
                                 format!("{directive}: displacement is not supported, ignored"),
@@ -1067,10 +1059,11 @@ impl Pbrt {
                 self.ir
                     .meshes
                     .push((format!("{i:04}-{name}.obj"), Arc::new(mesh)));
-                if kind == "plymesh" && !self.state.reverse {
-                    if let Some(f) = p.string("filename")? {
-                        self.plys.insert(self.resolve(&f), i);
-                    }
+                if kind == "plymesh"
+                    && !self.state.reverse
+                    && let Some(f) = p.string("filename")?
+                {
+                    self.plys.insert(self.resolve(&f), i);
                 }
                 GeometryIr::Mesh(i)
             }
@@ -1087,10 +1080,9 @@ impl Pbrt {
         };
         for k in ["alpha", "emissionfilename"] {
             if p.type_of(k).is_some() {
-                let _ =
-                    p.0.iter()
-                        .filter(|q| q.name == k)
-                        .for_each(|q| q.used.set(true));
+                p.0.iter()
+                    .filter(|q| q.name == k)
+                    .for_each(|q| q.used.set(true));
                 self.ir.warn(
                     loc,
                     format!("{directive}: parameter \"{k}\" is not supported, ignored"),
@@ -1157,7 +1149,7 @@ impl Pbrt {
                     "{directive}: needs \"integer indices\" (only {per} vertices may go without)"
                 ))),
             };
-        if indices.len() % per != 0 {
+        if !indices.len().is_multiple_of(per) {
             return Err(loc.error(format!(
                 "{directive}: {} indices, not a multiple of {per}",
                 indices.len()
@@ -1278,10 +1270,9 @@ impl Pbrt {
                 "savefp16",
                 "maxcomponentvalue",
             ] {
-                let _ =
-                    p.0.iter()
-                        .filter(|q| q.name == k)
-                        .for_each(|q| q.used.set(true));
+                p.0.iter()
+                    .filter(|q| q.name == k)
+                    .for_each(|q| q.used.set(true));
             }
             p.unused("Film", &mut self.ir.warnings);
             film.loc = Some(loc);
@@ -1304,7 +1295,7 @@ impl Pbrt {
             p.num_or("shutteropen", 0.0)?,
             p.num_or("shutterclose", 1.0)?,
         ];
-        if !(shutter[0] <= shutter[1]) {
+        if shutter[0] > shutter[1] {
             return Err(loc.error("Camera: shutteropen is after shutterclose"));
         }
         let moving = ctm[0] != ctm[1] || self.ir.shapes.iter().any(|s| s.transform_end.is_some());
@@ -1377,7 +1368,7 @@ impl Pbrt {
                     glam::DVec4::new(-1.0, 0.0, 0.0, 0.0),
                     glam::DVec4::W,
                 );
-                cam.pose = cam.pose * p_from_obscura;
+                cam.pose *= p_from_obscura;
                 cam.pose_end = cam.pose_end.map(|m| m * p_from_obscura);
             }
             other => {

@@ -386,10 +386,9 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(300))]
     #[test]
     fn no_mitsuba_input_panics(text in xml_soup()) {
-        if let Ok(imported) = parse_mitsuba(Path::new("/nonexistent/fuzz.xml"), &text) {
-            if let Ok(d) = imported.description() {
+        if let Ok(imported) = parse_mitsuba(Path::new("/nonexistent/fuzz.xml"), &text)
+            && let Ok(d) = imported.description() {
                 let _ = obscura_render::RenderScene::build(d);
             }
-        }
     }
 }

@@ -636,10 +636,9 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(300))]
     #[test]
     fn no_pbrt_input_panics(text in pbrt_soup()) {
-        if let Ok(imported) = parse_pbrt(Path::new("/nonexistent/fuzz.pbrt"), &text) {
-            if let Ok(d) = imported.description() {
+        if let Ok(imported) = parse_pbrt(Path::new("/nonexistent/fuzz.pbrt"), &text)
+            && let Ok(d) = imported.description() {
                 let _ = obscura_render::RenderScene::build(d);
             }
-        }
     }
 }

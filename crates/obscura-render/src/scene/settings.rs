@@ -280,6 +280,9 @@ pub struct StereoSettings {
     pub layout: StereoLayout,
 }
 
+/// A camera pose as a matrix: world from camera.
+pub type CameraPose = Transform<World, CameraSpace>;
+
 /// `[camera]`, validated: the camera crate's own types, each checked by the camera crate.
 #[derive(Clone, Debug)]
 pub struct CameraSettings {
@@ -321,10 +324,7 @@ pub struct CameraSettings {
     pub eye: Option<StereoEye>,
     /// `pose` (and `pose_end`): world from camera as matrices, instead of the look-at; any
     /// affine matrix, so also a pose that mirrors the image as pbrt's look-at does.
-    pub pose: Option<(
-        Transform<World, CameraSpace>,
-        Option<Transform<World, CameraSpace>>,
-    )>,
+    pub pose: Option<(CameraPose, Option<CameraPose>)>,
 }
 
 impl SceneDescription {
