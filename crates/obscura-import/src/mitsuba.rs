@@ -769,12 +769,10 @@ impl<'d, 'i> Mitsuba<'d, 'i> {
                 MaterialIr::Diffuse([0.5; 3])
             }
         };
-        let wanted = self
-            .attr(n, "id")?
-            .unwrap_or_else(|| format!("{kind}-{}", loc.line));
-        let name = self.ir.material_name(&wanted);
-        self.ir.materials.push((name.clone(), m, loc));
-        Ok(Some(name))
+        let id = self.attr(n, "id")?;
+        let anonymous = id.is_none();
+        let wanted = id.unwrap_or_else(|| format!("{kind}-{}", loc.line));
+        Ok(Some(self.ir.add_material(&wanted, m, &loc, anonymous)))
     }
 
     fn file(&self, n: Node, name: &str) -> Result<PathBuf, ImportError> {

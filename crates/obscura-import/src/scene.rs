@@ -101,6 +101,10 @@ pub(crate) struct Ir {
     pub(crate) lights: Vec<(LightIr, Location)>,
     pub(crate) meshes: Vec<(String, Arc<TriangleMesh>)>,
     pub(crate) warnings: Vec<String>,
+    /// The materials' names, for uniqueness.
+    names: std::collections::HashSet<String>,
+    /// Anonymous materials by their settings.
+    anonymous: HashMap<String, String>,
 }
 
 impl Ir {
@@ -109,8 +113,33 @@ impl Ir {
         self.warnings.push(format!("{loc}: {message}"));
     }
 
+    /// Adds a material under a unique bare-key name made from `wanted`; returns the name.
+    /// An `anonymous` material equal to an earlier anonymous one is that one (exporters write
+    /// a `Material` per shape).
+    pub(crate) fn add_material(
+        &mut self,
+        wanted: &str,
+        m: MaterialIr,
+        loc: &Location,
+        anonymous: bool,
+    ) -> String {
+        let key = format!("{m:?}");
+        if anonymous {
+            if let Some(name) = self.anonymous.get(&key) {
+                return name.clone();
+            }
+        }
+        let name = self.material_name(wanted);
+        self.names.insert(name.clone());
+        if anonymous {
+            self.anonymous.insert(key, name.clone());
+        }
+        self.materials.push((name.clone(), m, loc.clone()));
+        name
+    }
+
     /// A material's name, unique and a bare TOML key, from `wanted`.
-    pub(crate) fn material_name(&self, wanted: &str) -> String {
+    fn material_name(&self, wanted: &str) -> String {
         let mut base: String = wanted
             .chars()
             .map(|c| {
@@ -126,7 +155,7 @@ impl Ir {
         }
         let mut name = base.clone();
         let mut n = 1;
-        while self.materials.iter().any(|(m, _, _)| *m == name) {
+        while self.names.contains(&name) {
             n += 1;
             name = format!("{base}-{n}");
         }
@@ -357,7 +386,13 @@ fn emit(
 ) -> Result<(String, Vec<(usize, Location)>), ImportError> {
     let mut out = String::new();
     let mut origins = Vec::new();
-    let line = |out: &String| out.matches('\n').count() + 1;
+    // The line the text has reached, counted on from the last call (emitting stays linear).
+    let (mut counted, mut lines) = (0usize, 0usize);
+    let mut line = |out: &String| {
+        lines += out[counted..].matches('\n').count();
+        counted = out.len();
+        lines + 1
+    };
     let _ = writeln!(
         out,
         "# Imported from {} by obscura-import; every table says where it came from.",

@@ -16,7 +16,7 @@ pub(crate) enum Kind {
     Close,
 }
 
-/// A token and where it starts (1-based line and column).
+/// A token and where it starts (1-based line, and 1-based column in bytes).
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) struct Token {
     pub(crate) kind: Kind,
@@ -30,7 +30,8 @@ pub(crate) fn tokenize(text: &str) -> Result<Vec<Token>, (usize, usize, String)>
     let mut chars = text.char_indices().peekable();
     let (mut line, mut line_start) = (1usize, 0usize);
     while let Some(&(at, c)) = chars.peek() {
-        let column = text[line_start..at].chars().count() + 1;
+        // In bytes, so a long line (pbrt exporters write whole meshes on one) costs nothing.
+        let column = at - line_start + 1;
         let here = |kind| Token { kind, line, column };
         match c {
             '\n' => {

@@ -527,7 +527,7 @@ impl Pbrt {
                 let kind = c.string(d)?;
                 let p = c.params(d)?;
                 let wanted = format!("{kind}-{}", loc.line);
-                self.state.material = self.material(&wanted, &kind, &p, &loc)?;
+                self.state.material = self.material(&wanted, &kind, &p, &loc, true)?;
             }
             "MakeNamedMaterial" => {
                 let name = c.string(d)?;
@@ -537,7 +537,7 @@ impl Pbrt {
                         "MakeNamedMaterial \"{name}\": needs \"string type\""
                     ))
                 })?;
-                let m = self.material(&name, &kind, &p, &loc)?;
+                let m = self.material(&name, &kind, &p, &loc, false)?;
                 self.named_materials.insert(name, m);
             }
             "NamedMaterial" => {
@@ -759,6 +759,7 @@ impl Pbrt {
         kind: &str,
         p: &Params,
         loc: &Location,
+        anonymous: bool,
     ) -> Result<Option<String>, ImportError> {
         let directive = format!("material \"{kind}\"");
         let w = &mut self.ir.warnings;
@@ -908,9 +909,7 @@ impl Pbrt {
         // MakeNamedMaterial's own parameter; normal and displacement maps warn as unused.
         let _ = p.string("type");
         p.unused(&directive, &mut self.ir.warnings);
-        let name = self.ir.material_name(wanted);
-        self.ir.materials.push((name.clone(), m, loc.clone()));
-        Ok(Some(name))
+        Ok(Some(self.ir.add_material(wanted, m, loc, anonymous)))
     }
 
     fn light(&mut self, kind: &str, p: &Params, loc: &Location) -> Result<(), ImportError> {

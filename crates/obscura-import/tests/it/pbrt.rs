@@ -642,3 +642,38 @@ proptest! {
             }
     }
 }
+
+#[test]
+fn equal_anonymous_materials_are_shared_and_long_lines_are_cheap() {
+    // Exporters write a Material per shape: equal ones become one scene material.
+    let mut text = String::from("Camera \"perspective\"\nWorldBegin\n");
+    for i in 0..200 {
+        let r = if i % 2 == 0 {
+            "0.5 0.5 0.5"
+        } else {
+            "0.1 0.2 0.3"
+        };
+        text += &format!(
+            "AttributeBegin\nMaterial \"diffuse\" \"rgb reflectance\" [{r}]\nTranslate {i} 0 0\nShape \"sphere\"\nAttributeEnd\n"
+        );
+    }
+    // One mesh of 200 000 triangles written on a single line, as exporters do.
+    let n = 100_000;
+    let mut p = String::new();
+    let mut idx = String::new();
+    for i in 0..n {
+        p += &format!("{i} 0 0 {i} 1 0 {i} 0 1 ");
+        idx += &format!("{} {} {} ", 3 * i, 3 * i + 1, 3 * i + 2);
+    }
+    text += &format!("Shape \"trianglemesh\" \"point3 P\" [{p}] \"integer indices\" [{idx}]\n");
+    let start = std::time::Instant::now();
+    let d = import(&text).description().unwrap();
+    assert_eq!(d.materials.len(), 2);
+    assert_eq!(d.shapes.len(), 201);
+    // Linear work: well under a second even in a debug build on a shared machine.
+    assert!(
+        start.elapsed().as_secs_f64() < 10.0,
+        "{:?}",
+        start.elapsed()
+    );
+}

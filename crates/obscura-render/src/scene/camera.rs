@@ -471,4 +471,64 @@ mod tests {
             }
         }
     }
+    /// `pose` is world-from-camera, row-major: the look-at's own matrix gives the look-at's
+    /// camera, and a mirrored matrix the mirrored image.
+    #[test]
+    fn pose_is_a_world_from_camera_matrix() {
+        use obscura_camera::Camera;
+        use obscura_space::Point3;
+        let look = "eye = [1.0, 2.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\nup = [0.0, 1.0, 0.0]";
+        let scene = |camera: &str| {
+            format!("[film]\nresolution = [16, 12]\n[camera]\nfov = 40.0\n{camera}\n")
+        };
+        let path = std::path::Path::new("s.toml");
+        let by_look = crate::parse_description(path, &scene(look)).unwrap();
+        let m = by_look
+            .camera
+            .start
+            .pose()
+            .unwrap()
+            .matrix()
+            .transpose()
+            .to_cols_array();
+        let rows = |m: [f32; 16]| format!("{m:?}");
+        let by_pose =
+            crate::parse_description(path, &scene(&format!("pose = {}", rows(m)))).unwrap();
+        // Mirror camera x: the image flips left to right.
+        let mut mirrored = m;
+        for r in 0..3 {
+            mirrored[4 * r] = -mirrored[4 * r];
+        }
+        let by_mirror =
+            crate::parse_description(path, &scene(&format!("pose = {}", rows(mirrored)))).unwrap();
+        let (a, b, c) = (
+            crate::camera_of(&by_look).unwrap(),
+            crate::camera_of(&by_pose).unwrap(),
+            crate::camera_of(&by_mirror).unwrap(),
+        );
+        for p in [[0.3f32, 0.2, 0.1], [-0.5, 0.4, 1.0]] {
+            let p = Point3::new(p[0], p[1], p[2]);
+            let (ra, rb, rc) = (
+                a.project(p, 0.0).unwrap(),
+                b.project(p, 0.0).unwrap(),
+                c.project(p, 0.0).unwrap(),
+            );
+            assert!((ra.x - rb.x).abs() < 1e-3 && (ra.y - rb.y).abs() < 1e-3);
+            assert!((rc.x - (16.0 - ra.x)).abs() < 1e-3 && (rc.y - ra.y).abs() < 1e-3);
+        }
+        // One way only; pose_end needs pose; a singular matrix is refused at `camera.pose`.
+        for (camera, key) in [
+            (
+                format!("pose = {}\neye = [0.0, 0.0, 1.0]", rows(m)),
+                "camera.pose",
+            ),
+            (format!("pose_end = {}", rows(m)), "camera.pose_end"),
+            (format!("pose = {}", rows([0.0; 16])), "camera.pose"),
+        ] {
+            match crate::parse_description(path, &scene(&camera)) {
+                Err(RenderError::Scene { key: Some(k), .. }) => assert_eq!(k, key, "{camera}"),
+                other => panic!("{camera}: {other:?}"),
+            }
+        }
+    }
 }
