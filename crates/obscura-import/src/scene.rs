@@ -124,10 +124,8 @@ impl Ir {
         anonymous: bool,
     ) -> String {
         let key = format!("{m:?}");
-        if anonymous {
-            if let Some(name) = self.anonymous.get(&key) {
-                return name.clone();
-            }
+        if let Some(name) = self.anonymous.get(&key).filter(|_| anonymous) {
+            return name.clone();
         }
         let name = self.material_name(wanted);
         self.names.insert(name.clone());
