@@ -204,6 +204,22 @@ mod tests {
     }
 
     #[test]
+    fn normals_uvs_and_other_elements() {
+        let text = "ply\nformat ascii 1.0\ncomment made by hand\nelement vertex 3\nproperty double x\nproperty double y\nproperty double z\nproperty float nx\nproperty float ny\nproperty float nz\nproperty float s\nproperty float t\nelement edge 1\nproperty int vertex1\nproperty int vertex2\nelement face 1\nproperty list uchar uint vertex_index\nend_header\n0 0 0 0 0 1 0 0\n1 0 0 0 0 1 1 0\n0 1 0 0 0 1 0 1\n0 1\n3 0 1 2\n";
+        let m = parse_ply(text.as_bytes(), Path::new("n.ply")).unwrap();
+        assert_eq!(m.normals().unwrap()[1], Vec3::Z);
+        assert_eq!(m.uvs().unwrap()[2], Vec2::new(0.0, 1.0));
+        assert_eq!(m.triangles(), &[[0, 1, 2]]);
+        // Without normals and uvs in the header, the mesh has none.
+        assert!(
+            parse_ply(ASCII.as_bytes(), Path::new("q.ply"))
+                .unwrap()
+                .normals()
+                .is_none()
+        );
+    }
+
+    #[test]
     fn bad_index_is_an_error() {
         let bad = ASCII.replace("4 0 1 2 3", "3 0 1 9");
         assert!(

@@ -677,3 +677,26 @@ fn equal_anonymous_materials_are_shared_and_long_lines_are_cheap() {
         start.elapsed()
     );
 }
+
+#[test]
+fn a_sphere_at_world_plus_x_shows_left_in_pbrts_plain_look_at_and_right_after_scale() {
+    for (prefix, on_right) in [("", false), ("Scale -1 1 1\n", true)] {
+        let text = format!(
+            "{prefix}LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 40\n\
+             Film \"rgb\" \"integer xresolution\" 32 \"integer yresolution\" 16\nWorldBegin\n\
+             Translate 1.2 0 0\nShape \"sphere\" \"float radius\" 0.5\n"
+        );
+        let image = render_aov(import(&text).description().unwrap(), IntegratorKind::Depth);
+        let (mut sum, mut count) = (0.0, 0.0);
+        for y in 0..image.height {
+            for x in 0..image.width {
+                if image.pixel(x, y)[3] > 0.5 {
+                    sum += x as f64 + 0.5;
+                    count += 1.0;
+                }
+            }
+        }
+        assert!(count > 4.0, "the sphere is seen");
+        assert_eq!(sum / count > 16.0, on_right, "{prefix:?}: centroid at x = {}", sum / count);
+    }
+}
