@@ -697,6 +697,11 @@ fn a_sphere_at_world_plus_x_shows_left_in_pbrts_plain_look_at_and_right_after_sc
             }
         }
         assert!(count > 4.0, "the sphere is seen");
-        assert_eq!(sum / count > 16.0, on_right, "{prefix:?}: centroid at x = {}", sum / count);
+        assert_eq!(
+            sum / count > 16.0,
+            on_right,
+            "{prefix:?}: centroid at x = {}",
+            sum / count
+        );
     }
 }

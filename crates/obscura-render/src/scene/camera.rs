@@ -333,6 +333,13 @@ impl Cx<'_> {
                         )
                     })?,
                 };
+                if pose.is_some() && kind == CameraKind::Perspective {
+                    return Err(self.err(
+                        "camera.stereo",
+                        "an off-axis stereo pair moves its eyes along the look-at; give the \
+                         pose as eye, target and up, not as a matrix (pose)",
+                    ));
+                }
                 Some(StereoSettings { rig, layout })
             }
             _ => None,
@@ -524,6 +531,10 @@ mod tests {
             ),
             (format!("pose_end = {}", rows(m)), "camera.pose_end"),
             (format!("pose = {}", rows([0.0; 16])), "camera.pose"),
+            (
+                format!("pose = {}\n[camera.stereo]\nconvergence = 2.0", rows(m)),
+                "camera.stereo",
+            ),
         ] {
             match crate::parse_description(path, &scene(&camera)) {
                 Err(RenderError::Scene { key: Some(k), .. }) => assert_eq!(k, key, "{camera}"),
