@@ -1000,6 +1000,46 @@ impl Pbrt {
                     radius: radius as f32,
                 }
             }
+            "disk" | "cylinder" => {
+                let radius = p.num_or("radius", 1.0)?;
+                let phimax = p.num_or("phimax", 360.0)?.clamp(0.0, 360.0);
+                if radius.is_nan() || radius <= 0.0 || phimax <= 0.0 {
+                    return Err(loc.error(format!("{directive}: radius and phimax must be > 0")));
+                }
+                let mesh = if kind == "disk" {
+                    let (h, inner) = (p.num_or("height", 0.0)?, p.num_or("innerradius", 0.0)?);
+                    if inner.is_nan() || inner < 0.0 || inner >= radius {
+                        return Err(
+                            loc.error(format!("{directive}: innerradius must be in [0, radius)"))
+                        );
+                    }
+                    lathe(&[(inner, h), (radius, h)], phimax, true)
+                } else {
+                    let (z0, z1) = (p.num_or("zmin", -1.0)?, p.num_or("zmax", 1.0)?);
+                    if z0 == z1 {
+                        return Err(loc.error(format!("{directive}: zmin equals zmax")));
+                    }
+                    lathe(&[(radius, z0.min(z1)), (radius, z0.max(z1))], phimax, false)
+                };
+                let mesh = mesh.map_err(|e| loc.error(format!("{directive}: {e}")))?;
+                self.ir.warn(
+                    loc,
+                    format!(
+                        "{directive}: tessellated into {} triangles",
+                        mesh.triangle_count()
+                    ),
+                );
+                let mesh = if self.state.reverse {
+                    flipped(mesh)
+                } else {
+                    mesh
+                };
+                let i = self.ir.meshes.len();
+                self.ir
+                    .meshes
+                    .push((format!("{i:04}-{kind}.obj"), Arc::new(mesh)));
+                GeometryIr::Mesh(i)
+            }
             "trianglemesh" | "bilinearmesh" | "plymesh" => {
                 let mesh = match kind {
                     "plymesh" => {
@@ -1385,6 +1425,44 @@ impl Pbrt {
         self.ir.camera = Some(cam);
         Ok(())
     }
+}
+
+/// The surface swept by turning the polyline `profile` of (radius, z) points about +z by
+/// `phimax` degrees, in 128 steps per full turn: pbrt's disk (`disk`: facing +z) and cylinder
+/// (facing outwards), wound as pbrt orients them.
+fn lathe(profile: &[(f64, f64)], phimax: f64, disk: bool) -> Result<TriangleMesh, String> {
+    let steps = ((128.0 * phimax / 360.0).ceil() as u32).max(1);
+    let mut positions = Vec::new();
+    for i in 0..=steps {
+        let phi = (phimax * f64::from(i) / f64::from(steps)).to_radians();
+        for &(r, z) in profile {
+            positions.push(Vec3::new(
+                (r * phi.cos()) as f32,
+                (r * phi.sin()) as f32,
+                z as f32,
+            ));
+        }
+    }
+    let k = profile.len() as u32;
+    let mut triangles = Vec::new();
+    for i in 0..steps {
+        for j in 0..k - 1 {
+            let (a, b) = (i * k + j, (i + 1) * k + j);
+            let (c, d) = (b + 1, a + 1);
+            if disk {
+                // Outer ring d -> c at larger radius: (a, d, c), (a, c, b) face +z; at the
+                // centre a and b coincide and one triangle is enough.
+                triangles.push([a, d, c]);
+                if profile[j as usize].0 > 0.0 {
+                    triangles.push([a, c, b]);
+                }
+            } else {
+                // a, b at the lower z, d, c at the upper: (a, b, c), (a, c, d) face outwards.
+                triangles.extend([[a, b, c], [a, c, d]]);
+            }
+        }
+    }
+    TriangleMesh::new(positions, triangles, None, None).map_err(|e| e.to_string())
 }
 
 /// The same mesh with each triangle's winding reversed (pbrt's `ReverseOrientation`).

@@ -705,3 +705,53 @@ fn a_sphere_at_world_plus_x_shows_left_in_pbrts_plain_look_at_and_right_after_sc
         );
     }
 }
+
+#[test]
+fn disks_and_cylinders_are_tessellated_facing_as_in_pbrt() {
+    let imported = import(
+        "Camera \"perspective\"\nWorldBegin\nShape \"disk\" \"float radius\" 2 \"float height\" 0.5\n\
+         Shape \"cylinder\" \"float radius\" 0.5 \"float zmin\" 0 \"float zmax\" 3\n\
+         Shape \"disk\" \"float innerradius\" 0.5 \"float phimax\" 90\n",
+    );
+    assert!(imported.warnings.iter().any(|w| w.contains("tessellated")));
+    let d = imported.description().unwrap();
+    let mesh = |i: usize| match &d.shapes[i].geometry {
+        obscura_render::ShapeGeometry::Mesh { file } => d.meshes[file].clone(),
+        other => panic!("{other:?}"),
+    };
+    let normals = |i: usize| {
+        let m = mesh(i);
+        let p = m.positions();
+        m.triangles()
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|v| p[v as usize]);
+                ((b - a).cross(c - a), (a + b + c) / 3.0)
+            })
+            .collect::<Vec<_>>()
+    };
+    // pbrt's disk faces +z at its height; its area is pi r^2 (to the tessellation's error).
+    let area: f32 = normals(0)
+        .iter()
+        .map(|(n, c)| {
+            assert!(n.z > 0.0 && (c.z - 0.5).abs() < 1e-6);
+            0.5 * n.length()
+        })
+        .sum();
+    assert!(
+        (area - std::f32::consts::PI * 4.0).abs() < 0.01 * area,
+        "{area}"
+    );
+    // The cylinder faces outwards.
+    for (n, c) in normals(1) {
+        assert!(n.x * c.x + n.y * c.y > 0.0);
+    }
+    // A quarter annulus: within radii 0.5 and 1, x and y >= 0.
+    for (_, c) in normals(2) {
+        let r = (c.x * c.x + c.y * c.y).sqrt();
+        assert!(
+            (0.45..=1.0).contains(&r) && c.x >= -1e-6 && c.y >= -1e-6,
+            "{c:?}"
+        );
+    }
+}
