@@ -585,8 +585,11 @@ fn run_convert(scene_path: &Path, output: Option<PathBuf>) -> Result<(), RenderE
             format!("{}: the output must be a .toml file", output.display()),
         ));
     }
-    let (description, imported) = load_scene(scene_path)?;
-    let imported = imported.expect("an importable path is imported");
+    let imported = obscura_import::import(scene_path)?;
+    for w in &imported.warnings {
+        eprintln!("warning: {w}");
+    }
+    let description = imported.description()?;
     // Everything the renderer would refuse is refused before anything is written.
     RenderScene::build(description).map_err(|e| imported.locate(e))?;
     let written = imported.write(&output)?;
