@@ -392,3 +392,93 @@ proptest! {
             }
     }
 }
+
+#[test]
+fn orthographic_takes_its_extent_from_to_worlds_scale() {
+    // Mitsuba's orthographic camera sees [-1, 1] x [-1/aspect, 1/aspect] in its local frame,
+    // scaled by to_world: sample u = (1 - x/s) / 2, v = (1 - aspect y/s) / 2, x along its
+    // `left` axis.
+    let d = import(
+        r#"<scene version="3.0.0"><sensor type="orthographic">
+        <transform name="to_world"><scale value="2"/><lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/></transform>
+        <film type="hdrfilm"><integer name="width" value="40"/><integer name="height" value="20"/></film>
+        </sensor></scene>"#,
+    )
+    .description()
+    .unwrap();
+    assert_eq!(d.camera.kind, CameraKind::Orthographic);
+    let camera = camera_of(&d).unwrap();
+    for (x, y) in [(0.5f64, 0.25f64), (-1.5, -0.6), (0.0, 0.0)] {
+        // From (0, 0, 5) looking at -z with up +y, Mitsuba's `left` is cross(up, dir) = -x.
+        let left = -x;
+        let (u, v) = ((1.0 - left / 2.0) / 2.0, (1.0 - 2.0 * y / 2.0) / 2.0);
+        let r = camera
+            .project(Point3::<World>::new(x as f32, y as f32, 0.0), 0.0)
+            .unwrap();
+        assert!(
+            (r.x as f64 - 40.0 * u).abs() < 1e-3 && (r.y as f64 - 20.0 * v).abs() < 1e-3,
+            "({x}, {y}) -> ({}, {})",
+            r.x,
+            r.y
+        );
+    }
+}
+
+#[test]
+fn envmaps_keep_mitsubas_orientation() {
+    // A map red where u < 0.5, green elsewhere. Mitsuba looks a direction d up at
+    // u = atan2(d.x, -d.z) / 2 pi (mod 1): the +x hemisphere is red.
+    let dir = scratch("mitsuba-envmap");
+    let (w, h) = (8u32, 4u32);
+    let pixels = (0..w * h)
+        .map(|i| {
+            if i % w < w / 2 {
+                [1.0, 0.0, 0.0, 1.0]
+            } else {
+                [0.0, 1.0, 0.0, 1.0]
+            }
+        })
+        .collect();
+    let map = obscura_render::Image {
+        width: w,
+        height: h,
+        pixels,
+    };
+    obscura_render::write_image(
+        &dir.join("map.exr"),
+        &map,
+        &obscura_render::ImageInfo {
+            partial: false,
+            samples_per_pixel: 1,
+        },
+    )
+    .unwrap();
+    let xml = write(
+        &dir,
+        "env.xml",
+        r#"<scene version="3.0.0"><sensor type="perspective"/>
+        <emitter type="envmap"><string name="filename" value="map.exr"/></emitter></scene>"#,
+    );
+    let mut d = obscura_import::import(&xml).unwrap().description().unwrap();
+    // Look at it with an environment camera: image centre along -z, right half towards +x.
+    d.camera.kind = CameraKind::Environment;
+    d.camera.pose = None;
+    d.film.resolution = [16, 8];
+    d.sampler.spp = 1;
+    d.integrator.kind = IntegratorKind::Path;
+    let scene = obscura_render::RenderScene::build(d).unwrap();
+    let image = obscura_render::render(&scene, Default::default())
+        .unwrap()
+        .film
+        .resolve();
+    let towards_plus_x = image.pixel(12, 4);
+    let towards_minus_x = image.pixel(4, 4);
+    assert!(
+        towards_plus_x[0] > 0.9 && towards_plus_x[1] < 0.1,
+        "{towards_plus_x:?}"
+    );
+    assert!(
+        towards_minus_x[1] > 0.9 && towards_minus_x[0] < 0.1,
+        "{towards_minus_x:?}"
+    );
+}
