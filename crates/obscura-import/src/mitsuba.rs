@@ -972,7 +972,7 @@ impl<'d, 'i> Mitsuba<'d, 'i> {
                 let mirror = DMat4::from_scale(DVec3::new(-1.0, 1.0, 1.0));
                 LightIr::Environment {
                     radiance: [scale as f32; 3],
-                    file: Some(file),
+                    file: Some(crate::scene::MapIr::File(file)),
                     transform: Some(to_world.unwrap_or(DMat4::IDENTITY) * mirror),
                 }
             }

@@ -4,7 +4,7 @@
 use crate::error::{ImportError, Location};
 use glam::DMat4;
 use obscura_accel::TriangleMesh;
-use obscura_render::{RenderError, SceneDescription};
+use obscura_render::{Image, RenderError, SceneDescription};
 use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -84,9 +84,17 @@ pub(crate) enum LightIr {
     },
     Environment {
         radiance: [f32; 3],
-        file: Option<PathBuf>,
+        /// A map file the scene names, or one the import made (`Ir::maps`).
+        file: Option<MapIr>,
         transform: Option<DMat4>,
     },
+}
+
+/// An environment map: a file as the scene names it, or one the import made.
+#[derive(Clone, Debug)]
+pub(crate) enum MapIr {
+    File(PathBuf),
+    Made(usize),
 }
 
 /// An imported scene before it becomes text.
@@ -100,6 +108,8 @@ pub(crate) struct Ir {
     pub(crate) shapes: Vec<ShapeIr>,
     pub(crate) lights: Vec<(LightIr, Location)>,
     pub(crate) meshes: Vec<(String, Arc<TriangleMesh>)>,
+    /// Equirectangular maps the import made, by file name within the mesh folder.
+    pub(crate) maps: Vec<(String, Arc<Image>)>,
     pub(crate) warnings: Vec<String>,
     /// The materials' names, for uniqueness.
     names: std::collections::HashSet<String>,
@@ -173,6 +183,8 @@ pub struct Imported {
     mesh_dir: String,
     /// The meshes, by file name within the mesh folder.
     meshes: Vec<(String, Arc<TriangleMesh>)>,
+    /// The maps the import made, by file name within the mesh folder.
+    maps: Vec<(String, Arc<Image>)>,
     /// For each TOML line from which on an item came from a place in the imported files.
     origins: Vec<(usize, Location)>,
     /// What was approximated or left out, each naming file, line and directive.
@@ -192,6 +204,7 @@ impl Imported {
             toml,
             mesh_dir,
             meshes: ir.meshes,
+            maps: ir.maps,
             origins,
             warnings: ir.warnings,
         })
@@ -214,6 +227,12 @@ impl Imported {
             .map(|(name, m)| (base.join(&self.mesh_dir).join(name), m.clone()))
             .collect();
         d.meshes = Arc::new(meshes);
+        let maps: HashMap<PathBuf, Arc<Image>> = self
+            .maps
+            .iter()
+            .map(|(name, m)| (base.join(&self.mesh_dir).join(name), m.clone()))
+            .collect();
+        d.maps = Arc::new(maps);
         Ok(d)
     }
 
@@ -267,12 +286,21 @@ impl Imported {
             }
         };
         let mut written = Vec::new();
-        if !self.meshes.is_empty() {
+        if !self.meshes.is_empty() || !self.maps.is_empty() {
             let dir = out_base.join(&mesh_dir);
             std::fs::create_dir_all(&dir).map_err(io(&dir, "cannot create the mesh folder"))?;
             for (name, mesh) in &self.meshes {
                 let path = dir.join(name);
                 std::fs::write(&path, obj_text(mesh)).map_err(io(&path, "cannot write"))?;
+                written.push(path);
+            }
+            for (name, map) in &self.maps {
+                let path = dir.join(name);
+                let info = obscura_render::ImageInfo {
+                    partial: false,
+                    samples_per_pixel: 1,
+                };
+                obscura_render::write_image(&path, map, &info)?;
                 written.push(path);
             }
         }
@@ -587,9 +615,16 @@ fn emit(
                 transform,
             } => {
                 let _ = writeln!(out, "type = \"environment\"\nradiance = {}", v3(*radiance));
-                if let Some(f) = file {
-                    let rel = f.strip_prefix(base).unwrap_or(f);
-                    let _ = writeln!(out, "file = {}", quote(&rel.to_string_lossy()));
+                match file {
+                    Some(MapIr::File(f)) => {
+                        let rel = f.strip_prefix(base).unwrap_or(f);
+                        let _ = writeln!(out, "file = {}", quote(&rel.to_string_lossy()));
+                    }
+                    Some(MapIr::Made(i)) => {
+                        let name = ir.maps.get(*i).map_or("missing", |m| m.0.as_str());
+                        let _ = writeln!(out, "file = {}", quote(&format!("{mesh_dir}/{name}")));
+                    }
+                    None => {}
                 }
                 match transform {
                     Some(t) if *t != DMat4::IDENTITY => {

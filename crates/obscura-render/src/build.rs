@@ -156,8 +156,17 @@ impl RenderScene {
                     file: Some(map),
                     transform,
                 } => {
-                    let (w, h, texels) = read_environment_map(map)
-                        .map_err(|message| d.error(format!("{key}.file"), message))?;
+                    // A map given in memory (an imported scene's), else the file.
+                    let at_file = |message| d.error(format!("{key}.file"), message);
+                    let read;
+                    let image = match d.maps.get(map) {
+                        Some(image) => image.as_ref(),
+                        None => {
+                            read = read_exr_map(map).map_err(at_file)?;
+                            &read
+                        }
+                    };
+                    let (w, h, texels) = environment_texels(map, image).map_err(at_file)?;
                     let scale = Vec3::from(*radiance);
                     let texels = texels.into_iter().map(|t| t * scale).collect();
                     EnvironmentLight::from_texels(w, h, texels, transform.matrix())
@@ -329,14 +338,22 @@ pub(crate) fn build_camera(
     })
 }
 
-/// Reads an equirectangular EXR as linear RGB texels, row 0 at the top.
-fn read_environment_map(path: &Path) -> Result<(u32, u32, Vec<Vec3>), String> {
+/// Reads an equirectangular EXR map.
+fn read_exr_map(path: &Path) -> Result<crate::film::Image, String> {
     let (image, _) = crate::output::read_exr(path).map_err(|e| match e {
         RenderError::Encode { message, .. } if !path.exists() => {
             format!("{}: file not found ({message})", path.display())
         }
         other => other.to_string(),
     })?;
+    Ok(image)
+}
+
+/// An equirectangular map's texels as linear RGB, row 0 at the top, checked.
+fn environment_texels(
+    path: &Path,
+    image: &crate::film::Image,
+) -> Result<(u32, u32, Vec<Vec3>), String> {
     let texels: Vec<Vec3> = image
         .pixels
         .iter()

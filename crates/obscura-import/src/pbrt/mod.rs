@@ -7,6 +7,7 @@
 //! unless the file starts with `Scale -1 1 1`. The camera is therefore passed on as its exact
 //! matrix (`camera.pose`), never re-derived as a look-at: the image is pbrt's, mirror included.
 
+mod equal_area;
 mod lexer;
 mod params;
 
@@ -951,9 +952,37 @@ impl Pbrt {
             }
             "infinite" => {
                 if let Some(f) = p.string("filename")? {
-                    return Err(loc.error(format!(
-                        "LightSource \"infinite\": image \"{f}\": pbrt-v4's environment images use its equal-area square mapping, which Obscura does not read (it reads equirectangular EXR); not imported"
-                    )));
+                    // pbrt-v4's maps are equal-area squares: resampled into an
+                    // equirectangular map in the light's own frame.
+                    let path = self.resolve(&f);
+                    let (image, _) = obscura_render::read_exr(&path).map_err(|e| {
+                        loc.error(format!("LightSource \"infinite\": image \"{f}\": {e} (only EXR images are read)"))
+                    })?;
+                    if image.width != image.height || image.width == 0 {
+                        return Err(loc.error(format!(
+                            "LightSource \"infinite\": image \"{f}\" is {}x{}: pbrt-v4 needs a square equal-area image",
+                            image.width, image.height
+                        )));
+                    }
+                    if p.type_of("L").is_some() {
+                        return Err(
+                            loc.error("LightSource \"infinite\": give L or filename, not both")
+                        );
+                    }
+                    let map = equal_area::equirect_from_equal_area(&image);
+                    let i = self.ir.maps.len();
+                    self.ir
+                        .maps
+                        .push((format!("{i:04}-environment.exr"), Arc::new(map)));
+                    self.ir.lights.push((
+                        LightIr::Environment {
+                            radiance: [scale as f32; 3],
+                            file: Some(crate::scene::MapIr::Made(i)),
+                            transform: Some(ctm),
+                        },
+                        loc.clone(),
+                    ));
+                    return Ok(());
                 }
                 let l = p.rgb("L", w)?.unwrap_or([1.0; 3]);
                 LightIr::Environment {

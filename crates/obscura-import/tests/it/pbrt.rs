@@ -755,3 +755,75 @@ fn disks_and_cylinders_are_tessellated_facing_as_in_pbrt() {
         );
     }
 }
+
+#[test]
+fn image_infinite_lights_keep_pbrts_equal_area_orientation() {
+    // pbrt-v4's equal-area square: u > 1/2 is the +x hemisphere, the inner diamond
+    // |u - 1/2| + |v - 1/2| < 1/2 the +z one. Paint the first red and the second blue.
+    let dir = scratch("pbrt-envmap");
+    let n = 64u32;
+    let pixels = (0..n * n)
+        .map(|i| {
+            let (u, v) = (
+                (f64::from(i % n) + 0.5) / f64::from(n),
+                (f64::from(i / n) + 0.5) / f64::from(n),
+            );
+            let red = if u > 0.5 { 1.0 } else { 0.0 };
+            let blue = if (u - 0.5).abs() + (v - 0.5).abs() < 0.5 {
+                1.0
+            } else {
+                0.0
+            };
+            [red, 0.0, blue, 1.0]
+        })
+        .collect();
+    obscura_render::write_image(
+        &dir.join("sky.exr"),
+        &obscura_render::Image {
+            width: n,
+            height: n,
+            pixels,
+        },
+        &obscura_render::ImageInfo {
+            partial: false,
+            samples_per_pixel: 1,
+        },
+    )
+    .unwrap();
+    let scene = write(
+        &dir,
+        "sky.pbrt",
+        "Camera \"perspective\"\nWorldBegin\nLightSource \"infinite\" \"string filename\" \"sky.exr\"\n",
+    );
+    let imported = obscura_import::import(&scene).unwrap();
+    let look = |mut d: obscura_render::SceneDescription| {
+        // An environment camera with the scene format's default look-at: the image centre
+        // looks along world -z, the right half towards +x, the left and right edges along +z.
+        d.camera.kind = CameraKind::Environment;
+        d.camera.pose = None;
+        d.film.resolution = [32, 16];
+        d.sampler.spp = 1;
+        d.integrator.kind = IntegratorKind::Path;
+        let scene = obscura_render::RenderScene::build(d).unwrap();
+        obscura_render::render(&scene, Default::default())
+            .unwrap()
+            .film
+            .resolve()
+    };
+    let image = look(imported.description().unwrap());
+    let [r, _, b, _] = image.pixel(24, 8); // towards +x, on the horizon
+    assert!(r > 0.9, "+x is red: {r}");
+    let [r, _, _, _] = image.pixel(8, 8); // towards -x
+    assert!(r < 0.1, "-x is not red: {r}");
+    let [_, _, b_front, _] = image.pixel(16, 8); // towards -z
+    let [_, _, b_back, _] = image.pixel(0, 8); // towards +z
+    assert!(
+        b_front < 0.1 && b_back > 0.9,
+        "+z is blue: {b_front} {b_back} ({b})"
+    );
+    // Converted, the map is written beside the TOML and renders the same.
+    let out = dir.join("converted.toml");
+    imported.write(&out).unwrap();
+    let converted = look(obscura_render::load_description(&out).unwrap());
+    assert_eq!(converted.pixels, image.pixels);
+}

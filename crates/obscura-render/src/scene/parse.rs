@@ -81,6 +81,7 @@ pub fn parse_description(path: &Path, source: &str) -> Result<SceneDescription, 
         lights,
         ignored,
         meshes: Default::default(),
+        maps: Default::default(),
         source: source.into(),
     })
 }

@@ -38,6 +38,10 @@ pub struct SceneDescription {
     /// Meshes given in memory (by an importer), under the resolved path a `mesh` shape names:
     /// [`RenderScene::build`](crate::RenderScene::build) takes them instead of reading the file.
     pub meshes: std::sync::Arc<std::collections::HashMap<PathBuf, std::sync::Arc<TriangleMesh>>>,
+    /// Environment maps given in memory (by an importer), under the resolved path a light's
+    /// `file` names: [`RenderScene::build`](crate::RenderScene::build) takes them instead of
+    /// reading the file.
+    pub maps: std::sync::Arc<std::collections::HashMap<PathBuf, std::sync::Arc<crate::Image>>>,
     /// The file's text, read once: errors found after parsing (a mesh that fails to load, a
     /// camera the command line's resolution does not suit) find their key's line in it.
     pub(crate) source: std::sync::Arc<str>,
