@@ -40,12 +40,17 @@ pub(crate) fn square_to_sphere(p: [f64; 2]) -> DVec3 {
     DVec3::new(phi.cos().copysign(u) * s, phi.sin().copysign(v) * s, z)
 }
 
+/// The tallest equirectangular map made from an equal-area image.
+const MAX_HEIGHT: u32 = 4096;
+
 /// The equirectangular map (twice as wide as high, Obscura's mapping: row 0 looks along +y,
 /// the centre column along +z) of a square equal-area image, bilinearly sampled as pbrt
 /// does, row 0 of the image being v = 0.
 pub(crate) fn equirect_from_equal_area(square: &Image) -> Image {
     let n = square.width;
-    let (w, h) = (2 * n, n);
+    // Twice as wide as high, at most 8192 x 4096 texels (512 MiB of floats at most).
+    let h = n.min(MAX_HEIGHT);
+    let w = 2 * h;
     let texel = |x: i64, y: i64| {
         let clamp = |i: i64| i.clamp(0, i64::from(n) - 1) as u32;
         square.pixel(clamp(x), clamp(y))
