@@ -10,6 +10,8 @@
 //! - [`accel`]: meshes, spheres, quads, moving instances and BVHs (obvhs).
 //! - [`shade`]: materials, lights and the path tracer.
 //! - [`render`]: scene files, film, integrators and image output.
+//! - [`import`]: pbrt-v4 and Mitsuba 3 scenes (and PLY meshes) read into the renderer's scene
+//!   description.
 //!
 //! ```
 //! use camera_obscura::camera::{Camera, CameraSample};
@@ -40,6 +42,7 @@
 
 pub use obscura_accel as accel;
 pub use obscura_camera as camera;
+pub use obscura_import as import;
 pub use obscura_render as render;
 pub use obscura_sample as sample;
 pub use obscura_shade as shade;

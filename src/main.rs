@@ -2,6 +2,7 @@
 
 use clap::{Parser, Subcommand};
 use obscura_camera::CubeFace;
+use obscura_import::Imported;
 use obscura_render::{
     CameraKind, Checkpoint, Film, ImageInfo, IntegratorKind, OutputFormat, RenderError,
     RenderOptions, RenderScene, SceneDescription, StereoLayout, compose_stereo, load_description,
@@ -35,8 +36,17 @@ enum Command {
     Render(RenderArgs),
     /// Parse and validate a scene, print a summary, render nothing.
     Check {
-        /// The scene file (TOML).
+        /// The scene file (TOML, or pbrt-v4 .pbrt, or Mitsuba 3 .xml).
         scene: PathBuf,
+    },
+    /// Convert a pbrt-v4 (.pbrt) or Mitsuba 3 (.xml) scene to Obscura's TOML, its meshes to
+    /// OBJ files in OUT-meshes/ beside it.
+    Convert {
+        /// The scene file (.pbrt or .xml).
+        scene: PathBuf,
+        /// The TOML file to write [default: the scene's name with .toml]
+        #[arg(short = 'o', long = "output")]
+        output: Option<PathBuf>,
     },
 }
 
@@ -45,6 +55,9 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(args) => run_render(args),
         Command::Check { scene } => run_check(&scene).map(|()| ExitCode::SUCCESS),
+        Command::Convert { scene, output } => {
+            run_convert(&scene, output).map(|()| ExitCode::SUCCESS)
+        }
     };
     match result {
         Ok(code) => code,
@@ -65,7 +78,7 @@ fn setting(name: &'static str, message: impl Into<String>) -> RenderError {
 /// The `render` subcommand's arguments.
 #[derive(clap::Args)]
 struct RenderArgs {
-    /// The scene file (TOML).
+    /// The scene file (TOML, or pbrt-v4 .pbrt, or Mitsuba 3 .xml).
     #[arg(value_name = "SCENE")]
     scene_path: PathBuf,
     /// Output image, .exr or .png [default: the scene's name with .exr]
@@ -207,7 +220,7 @@ fn run_render(args: RenderArgs) -> Result<ExitCode, RenderError> {
         }
     }
 
-    let mut description = load_description(scene_path)?;
+    let (mut description, imported) = load_scene(scene_path)?;
     if let Some(spp) = args.spp {
         if spp == 0 {
             return Err(setting("--spp", "must be >= 1, got 0"));
@@ -239,7 +252,7 @@ fn run_render(args: RenderArgs) -> Result<ExitCode, RenderError> {
                 "checkpoints hold one image; a cube map or a stereo pair renders several",
             ));
         }
-        return render_views(views, &output, threads);
+        return render_views(views, &output, threads, imported.as_ref());
     }
     // The checkpoint's fingerprint: the scene file's bytes and the settings after overrides.
     let fingerprint = if args.checkpoint.is_some() || args.resume.is_some() {
@@ -252,7 +265,7 @@ fn run_render(args: RenderArgs) -> Result<ExitCode, RenderError> {
     } else {
         0
     };
-    let scene = RenderScene::build(description)?;
+    let scene = RenderScene::build(description).map_err(|e| locate(imported.as_ref(), e))?;
     report_skipped(&scene);
     let spp = scene.sampler.samples_per_pixel();
 
@@ -455,10 +468,11 @@ fn render_views(
     views: Views,
     output: &Path,
     threads: Option<usize>,
+    imported: Option<&Imported>,
 ) -> Result<ExitCode, RenderError> {
     let interrupts = Interrupts::install()?;
     let shoot = |d: SceneDescription| -> Result<Option<obscura_render::Image>, RenderError> {
-        let scene = RenderScene::build(d)?;
+        let scene = RenderScene::build(d).map_err(|e| locate(imported, e))?;
         report_skipped(&scene);
         let outcome = render(
             &scene,
@@ -533,12 +547,67 @@ fn report_skipped(scene: &RenderScene) {
     }
 }
 
+/// Reads a scene: TOML as it is, a .pbrt or .xml through obscura-import (whose warnings go to
+/// stderr); the import is kept to place later errors on its lines.
+fn load_scene(path: &Path) -> Result<(SceneDescription, Option<Imported>), RenderError> {
+    if !obscura_import::is_importable(path) {
+        return Ok((load_description(path)?, None));
+    }
+    let imported = obscura_import::import(path)?;
+    for w in &imported.warnings {
+        eprintln!("warning: {w}");
+    }
+    Ok((imported.description()?, Some(imported)))
+}
+
+/// A renderer error moved onto the imported file's line, for imported scenes.
+fn locate(imported: Option<&Imported>, e: RenderError) -> RenderError {
+    match imported {
+        Some(i) => i.locate(e),
+        None => e,
+    }
+}
+
+fn run_convert(scene_path: &Path, output: Option<PathBuf>) -> Result<(), RenderError> {
+    if !obscura_import::is_importable(scene_path) {
+        return Err(setting(
+            "convert",
+            format!(
+                "{}: expected a pbrt-v4 (.pbrt) or Mitsuba 3 (.xml) scene",
+                scene_path.display()
+            ),
+        ));
+    }
+    let output = output.unwrap_or_else(|| scene_path.with_extension("toml"));
+    if output.extension().and_then(|e| e.to_str()) != Some("toml") {
+        return Err(setting(
+            "-o",
+            format!("{}: the output must be a .toml file", output.display()),
+        ));
+    }
+    let imported = obscura_import::import(scene_path)?;
+    for w in &imported.warnings {
+        eprintln!("warning: {w}");
+    }
+    let description = imported.description()?;
+    // Everything the renderer would refuse is refused before anything is written.
+    RenderScene::build(description).map_err(|e| imported.locate(e))?;
+    let written = imported.write(&output)?;
+    println!(
+        "converted {} -> {} ({} files)",
+        scene_path.display(),
+        output.display(),
+        written.len()
+    );
+    Ok(())
+}
+
 fn run_check(scene_path: &Path) -> Result<(), RenderError> {
-    let description = load_description(scene_path)?;
+    let (description, imported) = load_scene(scene_path)?;
     for note in &description.ignored {
         eprintln!("note: {note}");
     }
-    let scene = RenderScene::build(description)?;
+    let scene = RenderScene::build(description).map_err(|e| locate(imported.as_ref(), e))?;
     report_skipped(&scene);
     let d = &scene.description;
     let kind = d.camera.kind.name();

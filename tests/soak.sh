@@ -5,7 +5,7 @@
 #   bash tests/soak.sh [CYCLES] [SCENE]        # default 100 cycles of scenes/spheres-thin-lens.toml
 #
 # Renders SCENE straight through once, then again while sending SIGINT at a random moment of
-# each run (0 to 300 ms after it starts, before or after its signal handlers are installed)
+# each run (0 to 200 ms after it starts, before or after its signal handlers are installed)
 # and resuming from the checkpoint every time, until CYCLES interrupts have landed; then lets
 # it finish. The final image must equal the straight one bit for bit and the folder must hold
 # no temporary or partial file. Exits 0 on success, 1 with a message otherwise.
@@ -17,8 +17,8 @@ cargo build --release --quiet
 bin=$PWD/target/release/obscura
 dir=$(mktemp -d /tmp/obscura-soak.XXXXXX)
 trap 'rm -rf "$dir"' EXIT
-# Large enough that 100 interrupts land before the end: about 40 s of rendering on 2 cores.
-flags=(--resolution 160x120 --spp 2048 --threads 2)
+# Large enough that 100 interrupts land before the end: a straight render takes about a minute on two quiet cores.
+flags=(--resolution 160x120 --spp 16384 --threads 2)
 
 "$bin" render "$scene" -o "$dir/straight.exr" "${flags[@]}" >/dev/null
 landed=0 runs=0 early=0
@@ -28,7 +28,7 @@ while [ "$landed" -lt "$cycles" ]; do
     "$bin" render "$scene" -o "$dir/out.exr" "${flags[@]}" \
         --checkpoint "$dir/soak.ckpt" --checkpoint-every 0 "${resume[@]}" >/dev/null 2>"$dir/err" &
     pid=$!
-    sleep "0.$(printf '%03d' $((RANDOM % 300)))"
+    sleep "0.$(printf '%03d' $((RANDOM % 200)))"
     kill -INT "$pid" 2>/dev/null || true
     set +e
     wait "$pid"

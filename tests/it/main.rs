@@ -3,6 +3,7 @@
 
 mod cli;
 mod gallery;
+mod import;
 mod opencv;
 mod py_fixture;
 mod robust;

@@ -89,7 +89,7 @@ impl RenderScene {
                     edge_v: (*edge_v).into(),
                 },
                 ShapeGeometry::Mesh { file: mesh_file } => {
-                    let mesh = match meshes.get(mesh_file) {
+                    let mesh = match meshes.get(mesh_file).or_else(|| d.meshes.get(mesh_file)) {
                         Some(m) => m.clone(),
                         None => {
                             let m = Arc::new(
@@ -156,8 +156,17 @@ impl RenderScene {
                     file: Some(map),
                     transform,
                 } => {
-                    let (w, h, texels) = read_environment_map(map)
-                        .map_err(|message| d.error(format!("{key}.file"), message))?;
+                    // A map given in memory (an imported scene's), else the file.
+                    let at_file = |message| d.error(format!("{key}.file"), message);
+                    let read;
+                    let image = match d.maps.get(map) {
+                        Some(image) => image.as_ref(),
+                        None => {
+                            read = read_exr_map(map).map_err(at_file)?;
+                            &read
+                        }
+                    };
+                    let (w, h, texels) = environment_texels(map, image).map_err(at_file)?;
                     let scale = Vec3::from(*radiance);
                     let texels = texels.into_iter().map(|t| t * scale).collect();
                     EnvironmentLight::from_texels(w, h, texels, transform.matrix())
@@ -273,9 +282,13 @@ pub(crate) fn build_camera(
     // The pose: OpenCV extrinsics, or the look-at(s), moved to one eye for a stereo pair.
     let rig = c.stereo.map(|s| s.rig);
     let eye = c.eye.zip(rig);
-    let pose = match c.extrinsics {
-        Some(x) => opencv_pose(x.rvec, x.tvec)?,
-        None => {
+    let pose = match (c.pose, c.extrinsics) {
+        (Some((start, Some(end))), _) if c.shutter.open < c.shutter.close => {
+            AnimatedTransform::new(start, c.shutter.open, end, c.shutter.close)?
+        }
+        (Some((start, _)), _) => AnimatedTransform::fixed(start),
+        (None, Some(x)) => opencv_pose(x.rvec, x.tvec)?,
+        (None, None) => {
             let for_eye = |look: LookAt| match eye {
                 Some((eye, rig)) => rig.eye_look_at(eye, look),
                 None => Ok(look),
@@ -325,22 +338,29 @@ pub(crate) fn build_camera(
     })
 }
 
-/// Reads an equirectangular EXR as linear RGB texels, row 0 at the top.
-fn read_environment_map(path: &Path) -> Result<(u32, u32, Vec<Vec3>), String> {
-    let bytes = std::fs::read(path).map_err(|e| {
-        if path.exists() {
-            format!("{}: cannot read EXR: {e}", path.display())
-        } else {
-            format!("{}: file not found ({e})", path.display())
+/// Reads an equirectangular EXR map.
+fn read_exr_map(path: &Path) -> Result<crate::film::Image, String> {
+    let (image, _) = crate::output::read_exr(path).map_err(|e| match e {
+        RenderError::Encode { message, .. } if !path.exists() => {
+            format!("{}: file not found ({message})", path.display())
         }
+        other => other.to_string(),
     })?;
-    environment_map_texels(&bytes, path)
+    Ok(image)
 }
 
 /// The texels of an equirectangular EXR's bytes (`path` names it in errors): width, height and
 /// linear RGB texels, row 0 at the top; an error for a texel that is negative, NaN or infinite.
 pub fn environment_map_texels(bytes: &[u8], path: &Path) -> Result<(u32, u32, Vec<Vec3>), String> {
     let (image, _) = crate::output::decode_exr(bytes, path).map_err(|e| e.to_string())?;
+    environment_texels(path, &image)
+}
+
+/// An equirectangular map's texels as linear RGB, row 0 at the top, checked.
+fn environment_texels(
+    path: &Path,
+    image: &crate::film::Image,
+) -> Result<(u32, u32, Vec<Vec3>), String> {
     let texels: Vec<Vec3> = image
         .pixels
         .iter()

@@ -12,7 +12,7 @@ use obscura_camera::{
     CameraError, CubeFace, FisheyeProjection, FovAxis, LookAt, OpenCvIntrinsics, ScreenWindow,
     Shutter, StereoRig, ThinLens, opencv_pose, validate_clip, validate_fov,
 };
-use obscura_space::{Point3, SpaceError, Vector3};
+use obscura_space::{Camera as CameraSpace, Point3, SpaceError, Transform, Vector3, World};
 
 /// The interaxial distance when `[camera.stereo]` does not give one: 65 mm, a typical adult's
 /// distance between the pupils, in metres.
@@ -158,6 +158,29 @@ impl Cx<'_> {
             }
             (None, Some(_)) => {
                 return Err(self.err("camera.tvec", "tvec needs rvec beside it"));
+            }
+        };
+        // Or as matrices, world from camera (what an imported scene's camera transform is).
+        let pose = match (c.pose, c.pose_end) {
+            (None, None) => None,
+            (None, Some(_)) => {
+                return Err(self.err("camera.pose_end", "pose_end needs pose beside it"));
+            }
+            (Some(start), end) => {
+                if look_given || extrinsics.is_some() {
+                    return Err(self.err(
+                        "camera.pose",
+                        "give the pose one way only: a look-at (eye, target, up), OpenCV \
+                         extrinsics (rvec, tvec) or a matrix (pose)",
+                    ));
+                }
+                let matrix = |key: &str, m: [f32; 16]| {
+                    self.finite(key, &m)?;
+                    Transform::<World, CameraSpace>::from_rows(m)
+                        .map_err(|e| self.err(key, e.to_string()))
+                };
+                let end = end.map(|m| matrix("camera.pose_end", m)).transpose()?;
+                Some((matrix("camera.pose", start)?, end))
             }
         };
         let v3 = |key: &str, v: Option<V3>, default: V3| -> Result<V3, RenderError> {
@@ -310,6 +333,13 @@ impl Cx<'_> {
                         )
                     })?,
                 };
+                if pose.is_some() && kind == CameraKind::Perspective {
+                    return Err(self.err(
+                        "camera.stereo",
+                        "an off-axis stereo pair moves its eyes along the look-at; give the \
+                         pose as eye, target and up, not as a matrix (pose)",
+                    ));
+                }
                 Some(StereoSettings { rig, layout })
             }
             _ => None,
@@ -334,6 +364,7 @@ impl Cx<'_> {
             lens_shift,
             stereo,
             eye: None,
+            pose,
         })
     }
 
@@ -444,6 +475,70 @@ mod tests {
                     assert_eq!(l, line, "{camera}");
                 }
                 other => panic!("{camera}: {other}"),
+            }
+        }
+    }
+    /// `pose` is world-from-camera, row-major: the look-at's own matrix gives the look-at's
+    /// camera, and a mirrored matrix the mirrored image.
+    #[test]
+    fn pose_is_a_world_from_camera_matrix() {
+        use obscura_camera::Camera;
+        use obscura_space::Point3;
+        let look = "eye = [1.0, 2.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\nup = [0.0, 1.0, 0.0]";
+        let scene = |camera: &str| {
+            format!("[film]\nresolution = [16, 12]\n[camera]\nfov = 40.0\n{camera}\n")
+        };
+        let path = std::path::Path::new("s.toml");
+        let by_look = crate::parse_description(path, &scene(look)).unwrap();
+        let m = by_look
+            .camera
+            .start
+            .pose()
+            .unwrap()
+            .matrix()
+            .transpose()
+            .to_cols_array();
+        let rows = |m: [f32; 16]| format!("{m:?}");
+        let by_pose =
+            crate::parse_description(path, &scene(&format!("pose = {}", rows(m)))).unwrap();
+        // Mirror camera x: the image flips left to right.
+        let mut mirrored = m;
+        for r in 0..3 {
+            mirrored[4 * r] = -mirrored[4 * r];
+        }
+        let by_mirror =
+            crate::parse_description(path, &scene(&format!("pose = {}", rows(mirrored)))).unwrap();
+        let (a, b, c) = (
+            crate::camera_of(&by_look).unwrap(),
+            crate::camera_of(&by_pose).unwrap(),
+            crate::camera_of(&by_mirror).unwrap(),
+        );
+        for p in [[0.3f32, 0.2, 0.1], [-0.5, 0.4, 1.0]] {
+            let p = Point3::new(p[0], p[1], p[2]);
+            let (ra, rb, rc) = (
+                a.project(p, 0.0).unwrap(),
+                b.project(p, 0.0).unwrap(),
+                c.project(p, 0.0).unwrap(),
+            );
+            assert!((ra.x - rb.x).abs() < 1e-3 && (ra.y - rb.y).abs() < 1e-3);
+            assert!((rc.x - (16.0 - ra.x)).abs() < 1e-3 && (rc.y - ra.y).abs() < 1e-3);
+        }
+        // One way only; pose_end needs pose; a singular matrix is refused at `camera.pose`.
+        for (camera, key) in [
+            (
+                format!("pose = {}\neye = [0.0, 0.0, 1.0]", rows(m)),
+                "camera.pose",
+            ),
+            (format!("pose_end = {}", rows(m)), "camera.pose_end"),
+            (format!("pose = {}", rows([0.0; 16])), "camera.pose"),
+            (
+                format!("pose = {}\n[camera.stereo]\nconvergence = 2.0", rows(m)),
+                "camera.stereo",
+            ),
+        ] {
+            match crate::parse_description(path, &scene(&camera)) {
+                Err(RenderError::Scene { key: Some(k), .. }) => assert_eq!(k, key, "{camera}"),
+                other => panic!("{camera}: {other:?}"),
             }
         }
     }

@@ -18,7 +18,7 @@ pub use camera::DEFAULT_INTERAXIAL;
 pub(crate) use camera::camera_key;
 pub use parse::{load_description, parse_description};
 pub use settings::{
-    CameraKind, CameraSettings, Extrinsics, FilmSettings, FilterSettings, IntegratorKind,
-    IntegratorSettings, LightSettings, MaterialSettings, SamplerSettings, SceneDescription,
-    ShapeGeometry, ShapeSettings, StereoLayout, StereoSettings,
+    CameraKind, CameraPose, CameraSettings, Extrinsics, FilmSettings, FilterSettings,
+    IntegratorKind, IntegratorSettings, LightSettings, MaterialSettings, SamplerSettings,
+    SceneDescription, ShapeGeometry, ShapeSettings, StereoLayout, StereoSettings,
 };

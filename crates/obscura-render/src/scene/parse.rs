@@ -80,6 +80,8 @@ pub fn parse_description(path: &Path, source: &str) -> Result<SceneDescription, 
         shapes,
         lights,
         ignored,
+        meshes: Default::default(),
+        maps: Default::default(),
         source: source.into(),
     })
 }

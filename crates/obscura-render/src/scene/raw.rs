@@ -79,6 +79,8 @@ pub(super) struct RawCamera {
     pub(super) face: Option<String>,
     pub(super) lens_shift: Option<[f32; 2]>,
     pub(super) stereo: Option<RawStereo>,
+    pub(super) pose: Option<[f32; 16]>,
+    pub(super) pose_end: Option<[f32; 16]>,
 }
 
 #[derive(Deserialize)]

@@ -1,12 +1,13 @@
 //! The public settings types of a validated scene file.
 
 use crate::error::RenderError;
+use obscura_accel::TriangleMesh;
 use obscura_camera::{
     CubeFace, FisheyeProjection, FovAxis, LookAt, OpenCvIntrinsics, ScreenWindow, Shutter,
     StereoEye, StereoRig, ThinLens,
 };
 use obscura_sample::SamplerKind;
-use obscura_space::{Object, Transform, World};
+use obscura_space::{Camera as CameraSpace, Object, Transform, World};
 use std::path::PathBuf;
 
 /// Three numbers of the scene file: a point, vector or colour.
@@ -34,6 +35,13 @@ pub struct SceneDescription {
     /// Keys that were given but that the chosen model ignores (e.g. `fov` on an orthographic
     /// camera): worth a note to the user, not an error.
     pub ignored: Vec<String>,
+    /// Meshes given in memory (by an importer), under the resolved path a `mesh` shape names:
+    /// [`RenderScene::build`](crate::RenderScene::build) takes them instead of reading the file.
+    pub meshes: std::sync::Arc<std::collections::HashMap<PathBuf, std::sync::Arc<TriangleMesh>>>,
+    /// Environment maps given in memory (by an importer), under the resolved path a light's
+    /// `file` names: [`RenderScene::build`](crate::RenderScene::build) takes them instead of
+    /// reading the file.
+    pub maps: std::sync::Arc<std::collections::HashMap<PathBuf, std::sync::Arc<crate::Image>>>,
     /// The file's text, read once: errors found after parsing (a mesh that fails to load, a
     /// camera the command line's resolution does not suit) find their key's line in it.
     pub(crate) source: std::sync::Arc<str>,
@@ -276,6 +284,9 @@ pub struct StereoSettings {
     pub layout: StereoLayout,
 }
 
+/// A camera pose as a matrix: world from camera.
+pub type CameraPose = Transform<World, CameraSpace>;
+
 /// `[camera]`, validated: the camera crate's own types, each checked by the camera crate.
 #[derive(Clone, Debug)]
 pub struct CameraSettings {
@@ -315,6 +326,9 @@ pub struct CameraSettings {
     pub stereo: Option<StereoSettings>,
     /// Which eye of the stereo pair this description renders; None for the rig's centre.
     pub eye: Option<StereoEye>,
+    /// `pose` (and `pose_end`): world from camera as matrices, instead of the look-at; any
+    /// affine matrix, so also a pose that mirrors the image as pbrt's look-at does.
+    pub pose: Option<(CameraPose, Option<CameraPose>)>,
 }
 
 impl SceneDescription {

@@ -1,0 +1,207 @@
+//! Imported scenes through the command line: the shipped .pbrt and .xml scenes render what
+//! the shipped TOML renders, every flag applies to them, bad input exits 2 naming file and
+//! line, and `obscura convert` writes TOML that renders the same image bit for bit.
+
+use super::{obscura, render_image, root, scratch, shipped, write};
+use obscura_render::{IntegratorKind, SceneDescription};
+
+fn run(args: &[&str]) -> (i32, String, String) {
+    let out = obscura().args(args).output().unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn imported(name: &str) -> SceneDescription {
+    obscura_import::import(&root().join("scenes").join(name))
+        .unwrap()
+        .description()
+        .unwrap()
+}
+
+#[test]
+fn shipped_pbrt_and_mitsuba_scenes_match_the_shipped_toml() {
+    let reference = shipped("spheres-perspective.toml");
+    for name in ["spheres-perspective.pbrt", "spheres-perspective.xml"] {
+        for kind in [IntegratorKind::Depth, IntegratorKind::Position] {
+            // The same samples on both sides: the formats' samplers differ.
+            let small = |mut d: SceneDescription| {
+                d.sampler = reference.sampler;
+                d.sampler.spp = 1;
+                d.integrator.kind = kind;
+                d.film.resolution = [64, 48];
+                d
+            };
+            let a = render_image(small(imported(name)), 1);
+            let b = render_image(small(reference.clone()), 1);
+            let mut worst = 0.0f32;
+            for y in 0..a.height {
+                for x in 0..a.width {
+                    let (p, q) = (a.pixel(x, y), b.pixel(x, y));
+                    for c in 0..4 {
+                        worst = worst.max((p[c] - q[c]).abs() / p[c].abs().max(1.0));
+                    }
+                }
+            }
+            assert!(
+                worst < 1e-4,
+                "{name} {kind:?}: worst relative difference {worst}"
+            );
+        }
+    }
+}
+
+#[test]
+fn every_flag_applies_to_imported_scenes() {
+    let dir = scratch("import-flags");
+    for scene in ["spheres-perspective.pbrt", "spheres-perspective.xml"] {
+        let scene = root().join("scenes").join(scene);
+        for kind in IntegratorKind::ALL {
+            let out = dir.join(format!("{}.exr", kind.name()));
+            let (code, stdout, stderr) = run(&[
+                "render",
+                scene.to_str().unwrap(),
+                "-o",
+                out.to_str().unwrap(),
+                "--spp",
+                "1",
+                "--seed",
+                "3",
+                "--resolution",
+                "24x16",
+                "--threads",
+                "1",
+                "--integrator",
+                kind.name(),
+            ]);
+            assert_eq!(code, 0, "{stderr}");
+            assert!(
+                stdout.contains("24x16, 1 spp") && stdout.contains(kind.name()),
+                "{stdout}"
+            );
+            let (image, _) = obscura_render::read_exr(&out).unwrap();
+            assert_eq!((image.width, image.height), (24, 16));
+        }
+    }
+    let (code, stdout, _) = run(&[
+        "check",
+        root()
+            .join("scenes/spheres-perspective.xml")
+            .to_str()
+            .unwrap(),
+    ]);
+    assert_eq!(code, 0);
+    assert!(
+        stdout.contains("ok: 320x240 perspective camera, 4 shapes"),
+        "{stdout}"
+    );
+}
+
+#[test]
+fn bad_imported_scenes_exit_2_naming_file_and_line() {
+    let dir = scratch("import-bad");
+    for (name, text, line) in [
+        (
+            "a.pbrt",
+            "Camera \"perspective\"\nWorldBegin\n\nShape \"sphere\" \"float radius\" [ -1 ]\n",
+            4,
+        ),
+        (
+            "b.pbrt",
+            "Camera \"perspective\" \"float fov\" [ 200 ]\nWorldBegin\n",
+            1,
+        ),
+        (
+            "c.pbrt",
+            "Camera \"perspective\"\nWorldBegin\nShape \"plymesh\" \"string filename\" \"gone.ply\"\n",
+            3,
+        ),
+        (
+            "d.xml",
+            "<scene version=\"3.0.0\">\n<sensor type=\"perspective\">\n</scene>\n",
+            3,
+        ),
+        (
+            "e.xml",
+            "<scene version=\"3.0.0\">\n<sensor type=\"perspective\"/>\n<bsdf type=\"dielectric\" id=\"g\"><string name=\"int_ior\" value=\"unobtainium\"/></bsdf>\n</scene>\n",
+            3,
+        ),
+    ] {
+        let scene = write(&dir, name, text);
+        let out = dir.join("out.exr");
+        for args in [
+            vec![
+                "render",
+                scene.to_str().unwrap(),
+                "-o",
+                out.to_str().unwrap(),
+            ],
+            vec!["check", scene.to_str().unwrap()],
+            vec![
+                "convert",
+                scene.to_str().unwrap(),
+                "-o",
+                dir.join("out.toml").to_str().unwrap(),
+            ],
+        ] {
+            let (code, _, stderr) = run(&args);
+            assert_eq!(code, 2, "{name}: {stderr}");
+            assert!(
+                stderr.contains(&format!("{name}:{line}")),
+                "{name}: the message must name the file and line {line}: {stderr}"
+            );
+            assert!(!stderr.contains("panicked"), "{stderr}");
+            assert!(
+                !out.exists() && !dir.join("out.toml").exists(),
+                "nothing is written"
+            );
+        }
+    }
+}
+
+#[test]
+fn convert_writes_toml_that_renders_bit_for_bit_the_same() {
+    let dir = scratch("import-convert");
+    let scene = root().join("scenes").join("spheres-perspective.pbrt");
+    let toml = dir.join("converted.toml");
+    let (code, stdout, stderr) = run(&[
+        "convert",
+        scene.to_str().unwrap(),
+        "-o",
+        toml.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.contains("converted.toml"), "{stdout}");
+    assert!(
+        dir.join("converted-meshes").is_dir(),
+        "the bilinear floor becomes an OBJ"
+    );
+    let flags = ["--spp", "2", "--resolution", "40x30", "--threads", "1"];
+    let render = |scene: &std::path::Path, out: &str| {
+        let out = dir.join(out);
+        let mut args = vec![
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        args.extend(flags);
+        let (code, _, stderr) = run(&args);
+        assert_eq!(code, 0, "{stderr}");
+        obscura_render::read_exr(&out).unwrap().0
+    };
+    let a = render(&scene, "from-pbrt.exr");
+    let b = render(&toml, "from-toml.exr");
+    assert_eq!(a.pixels, b.pixels);
+    // A TOML scene is not something to convert.
+    let (code, _, stderr) = run(&[
+        "convert",
+        root()
+            .join("scenes/spheres-perspective.toml")
+            .to_str()
+            .unwrap(),
+    ]);
+    assert_eq!(code, 2, "{stderr}");
+}
