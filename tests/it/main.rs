@@ -4,6 +4,7 @@
 mod cli;
 mod gallery;
 mod opencv;
+mod realistic;
 mod robust;
 mod scenes;
 mod views;

@@ -79,6 +79,10 @@ pub(super) struct RawCamera {
     pub(super) face: Option<String>,
     pub(super) lens_shift: Option<[f32; 2]>,
     pub(super) stereo: Option<RawStereo>,
+    pub(super) lens_file: Option<String>,
+    pub(super) aperture_diameter: Option<f32>,
+    pub(super) focus_distance: Option<f32>,
+    pub(super) film_diagonal: Option<f32>,
 }
 
 #[derive(Deserialize)]

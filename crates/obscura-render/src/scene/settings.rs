@@ -2,8 +2,8 @@
 
 use crate::error::RenderError;
 use obscura_camera::{
-    CubeFace, FisheyeProjection, FovAxis, LookAt, OpenCvIntrinsics, ScreenWindow, Shutter,
-    StereoEye, StereoRig, ThinLens,
+    CubeFace, FisheyeProjection, FovAxis, LensPrescription, LookAt, OpenCvIntrinsics, ScreenWindow,
+    Shutter, StereoEye, StereoRig, ThinLens,
 };
 use obscura_sample::SamplerKind;
 use obscura_space::{Object, Transform, World};
@@ -196,11 +196,13 @@ pub enum CameraKind {
     CubeFace,
     /// Omni-directional stereo: both eyes' equirectangular panoramas, left on top.
     Ods,
+    /// A lens system traced element by element (`type = "realistic"`, with `lens_file`).
+    Realistic,
 }
 
 impl CameraKind {
     /// Every model, in the order the scene format lists them.
-    pub const ALL: [CameraKind; 10] = [
+    pub const ALL: [CameraKind; 11] = [
         CameraKind::Perspective,
         CameraKind::Orthographic,
         CameraKind::Environment,
@@ -211,6 +213,7 @@ impl CameraKind {
         CameraKind::Octahedral,
         CameraKind::CubeFace,
         CameraKind::Ods,
+        CameraKind::Realistic,
     ];
 
     /// The model's `type` in the scene file.
@@ -226,6 +229,7 @@ impl CameraKind {
             CameraKind::Octahedral => "octahedral",
             CameraKind::CubeFace => "cube_face",
             CameraKind::Ods => "ods",
+            CameraKind::Realistic => "realistic",
         }
     }
 
@@ -315,6 +319,23 @@ pub struct CameraSettings {
     pub stereo: Option<StereoSettings>,
     /// Which eye of the stereo pair this description renders; None for the rig's centre.
     pub eye: Option<StereoEye>,
+    /// The realistic camera's lens system and settings (None for the other models).
+    pub realistic: Option<RealisticSettings>,
+}
+
+/// The `[camera]` keys of `type = "realistic"`, with the lens file read and parsed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RealisticSettings {
+    /// `lens_file`, resolved against the scene file's folder.
+    pub lens_file: PathBuf,
+    /// The prescription the file holds.
+    pub prescription: LensPrescription,
+    /// `aperture_diameter` (mm); None for the stop's full diameter.
+    pub aperture_diameter: Option<f32>,
+    /// `focus_distance` (world units, metres), from the film plane.
+    pub focus_distance: f32,
+    /// `film_diagonal` (mm).
+    pub film_diagonal: f32,
 }
 
 impl SceneDescription {
