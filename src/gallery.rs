@@ -5,7 +5,7 @@
 //! rendered once or several times with parameters varied, the panels laid side by side into one
 //! opaque PNG of the same name. [`generate`] does it all; [`FIGURES`] names what it makes.
 
-use obscura_camera::{CubeFace, FisheyeProjection, OpenCvIntrinsics};
+use obscura_camera::{CubeFace, FisheyeProjection, LensPrescription, OpenCvIntrinsics};
 use obscura_render::{
     DepthOfField, Image, ImageInfo, RenderError, RenderOptions, RenderScene, SceneDescription,
     compose_stereo, depth_of_field, motion_blur, parse_description, render, screen_buffers,
@@ -58,7 +58,7 @@ macro_rules! figure {
 }
 
 /// Every figure the gallery makes, in order.
-pub const FIGURES: [Figure; 20] = [
+pub const FIGURES: [Figure; 21] = [
     figure!("projection-perspective"),
     figure!("projection-orthographic"),
     figure!("dof-lens-radius"),
@@ -79,6 +79,28 @@ pub const FIGURES: [Figure; 20] = [
     figure!("stereo-anaglyph"),
     figure!("ods"),
     figure!("lens-shift"),
+    figure!("realistic-lenses"),
+];
+
+/// The `realistic-lenses` row: each lens file (written into `lenses/` beside the scene), its
+/// text, and the distance (metres) of the camera from the sphere's plane, 10 mm per millimetre
+/// of focal length so that the sphere keeps its size on the film.
+pub const LENS_PANELS: [(&str, &str, f32); 3] = [
+    (
+        "wide-angle-22mm.dat",
+        include_str!("../scenes/lenses/wide-angle-22mm.dat"),
+        0.22,
+    ),
+    (
+        "double-gauss-50mm.dat",
+        include_str!("../scenes/lenses/double-gauss-50mm.dat"),
+        0.5,
+    ),
+    (
+        "telephoto-250mm.dat",
+        include_str!("../scenes/lenses/telephoto-250mm.dat"),
+        2.5,
+    ),
 ];
 
 /// The `fisheye-projections` row: each projection and its field of view in degrees (the
@@ -140,6 +162,24 @@ fn make_figure(out_dir: &Path, figure: Figure, quality: Quality) -> Result<Made,
             action: "cannot write",
             source,
         })?;
+    }
+    // The realistic figure's lens files go beside it too, where its lens_file finds them.
+    if figure.name == "realistic-lenses" {
+        let dir = out_dir.join("lenses");
+        let io = |file: PathBuf| {
+            move |source| RenderError::Io {
+                file,
+                action: "cannot write",
+                source,
+            }
+        };
+        std::fs::create_dir_all(&dir).map_err(io(dir.clone()))?;
+        for (name, text, _) in LENS_PANELS {
+            let path = dir.join(name);
+            if std::fs::read_to_string(&path).ok().as_deref() != Some(text) {
+                std::fs::write(&path, text).map_err(io(path.clone()))?;
+            }
+        }
     }
     let mut base = parse_description(&scene_path, figure.scene)?;
     let full = base.film.resolution;
@@ -230,6 +270,25 @@ fn make_figure(out_dir: &Path, figure: Figure, quality: Quality) -> Result<Made,
             look.target.y += depth * 2.0 * half_height * shift;
             vec![shoot(tilted)?, shoot(base)?]
         }
+        "realistic-lenses" => LENS_PANELS
+            .iter()
+            .map(|&(name, text, distance)| {
+                let mut d = base.clone();
+                if let Some(r) = &mut d.camera.realistic {
+                    r.prescription =
+                        LensPrescription::parse(text).map_err(|e| RenderError::Scene {
+                            file: out_dir.join("lenses").join(name),
+                            line: None,
+                            key: Some("camera.lens_file".into()),
+                            message: e.to_string(),
+                        })?;
+                    r.lens_file = out_dir.join("lenses").join(name);
+                    r.focus_distance = distance;
+                }
+                d.camera.start.eye.z = distance;
+                shoot(d)
+            })
+            .collect::<Result<_, _>>()?,
         "postprocess-dof" | "postprocess-motion" => {
             let (distributed, post) = compare(base, figure.name == "postprocess-dof")?;
             let diff = difference(&distributed, &post);

@@ -6,6 +6,7 @@ mod gallery;
 mod import;
 mod opencv;
 mod py_fixture;
+mod realistic;
 mod robust;
 mod scenes;
 mod soak;

@@ -54,11 +54,14 @@ fn five_interrupts_and_resumes_equal_the_straight_render() {
         if checkpoint.exists() {
             cmd.args(["--resume", checkpoint.to_str().unwrap()]);
         }
-        let mut child = cmd.stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
+        let mut child = cmd
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
         // A checkpoint newer than `before` means the signal handlers are installed.
         wait_until("the render has saved new passes", || {
-            passes_in(&checkpoint) > before + wait_passes
-                || child.try_wait().unwrap().is_some()
+            passes_in(&checkpoint) > before + wait_passes || child.try_wait().unwrap().is_some()
         });
         if child.try_wait().unwrap().is_none() {
             send(&child, "INT");
@@ -73,7 +76,10 @@ fn five_interrupts_and_resumes_equal_the_straight_render() {
         // The interrupted run saved at least the passes the test waited for.
         assert!(passes_in(&checkpoint) > before + wait_passes, "{stderr}");
     }
-    assert!(interrupted >= 3, "the render finished before it was interrupted three times");
+    assert!(
+        interrupted >= 3,
+        "the render finished before it was interrupted three times"
+    );
 
     // The last run goes to the end from the checkpoint.
     let status = obscura()
@@ -83,6 +89,9 @@ fn five_interrupts_and_resumes_equal_the_straight_render() {
         .output()
         .unwrap();
     assert!(status.status.success(), "{status:?}");
-    assert_eq!(std::fs::read(&out).unwrap(), std::fs::read(&straight).unwrap());
+    assert_eq!(
+        std::fs::read(&out).unwrap(),
+        std::fs::read(&straight).unwrap()
+    );
     assert_eq!(names_in(&dir), ["out.exr", "soak.ckpt", "straight.exr"]);
 }

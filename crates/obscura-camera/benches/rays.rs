@@ -8,8 +8,9 @@
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use obscura_camera::{
-    AnyCamera, Camera, CameraBase, CameraSample, EnvironmentCamera, FilmGeometry, FovAxis, LookAt,
-    OrthographicCamera, PerspectiveCamera, Shutter, ThinLens, look_at_pose,
+    AnyCamera, Camera, CameraBase, CameraSample, EnvironmentCamera, FilmGeometry, FovAxis,
+    LensPrescription, LookAt, OrthographicCamera, PerspectiveCamera, RealisticCamera,
+    RealisticLens, Shutter, ThinLens, look_at_pose,
 };
 use obscura_space::{Point2, Point3, Vector3};
 use std::hint::black_box;
@@ -62,6 +63,22 @@ fn cameras(moving: bool) -> Vec<(String, AnyCamera)> {
         (
             format!("environment{suffix}"),
             EnvironmentCamera::new(base()).unwrap().into(),
+        ),
+        (
+            format!("realistic double gauss{suffix}"),
+            RealisticCamera::new(
+                base(),
+                &LensPrescription::parse(include_str!(
+                    "../../../scenes/lenses/double-gauss-50mm.dat"
+                ))
+                .unwrap(),
+                RealisticLens {
+                    focus_distance: 5.0,
+                    ..RealisticLens::default()
+                },
+            )
+            .unwrap()
+            .into(),
         ),
     ]
 }

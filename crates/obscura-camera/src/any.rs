@@ -11,6 +11,7 @@ use crate::opencv::OpenCvCamera;
 use crate::opencv_fisheye::OpenCvFisheyeCamera;
 use crate::orthographic::OrthographicCamera;
 use crate::perspective::PerspectiveCamera;
+use crate::realistic::RealisticCamera;
 use obscura_space::{Point2, Point3, Raster, World};
 
 /// Any of the camera models, dispatched by `match` (no trait objects on the per-ray path).
@@ -39,6 +40,8 @@ pub enum AnyCamera {
     OpenCv(OpenCvCamera),
     /// An OpenCV (Kannala-Brandt) fisheye camera.
     OpenCvFisheye(OpenCvFisheyeCamera),
+    /// A lens system traced element by element.
+    Realistic(RealisticCamera),
 }
 
 macro_rules! dispatch {
@@ -54,6 +57,7 @@ macro_rules! dispatch {
             AnyCamera::Ods($c) => $e,
             AnyCamera::OpenCv($c) => $e,
             AnyCamera::OpenCvFisheye($c) => $e,
+            AnyCamera::Realistic($c) => $e,
         }
     };
 }
@@ -133,5 +137,10 @@ impl From<OpenCvCamera> for AnyCamera {
 impl From<OpenCvFisheyeCamera> for AnyCamera {
     fn from(c: OpenCvFisheyeCamera) -> Self {
         AnyCamera::OpenCvFisheye(c)
+    }
+}
+impl From<RealisticCamera> for AnyCamera {
+    fn from(c: RealisticCamera) -> Self {
+        AnyCamera::Realistic(c)
     }
 }

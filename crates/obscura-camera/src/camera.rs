@@ -65,7 +65,8 @@ impl CameraSample {
 pub struct CameraRay {
     /// The ray; `t` is a distance along it, since the direction is unit length.
     pub ray: Ray<World>,
-    /// The ray's weight (1 for every model here).
+    /// The ray's weight: 1 for every model but the realistic camera, whose weight carries
+    /// its radiometry (see [`RealisticCamera`](crate::RealisticCamera)).
     pub weight: f32,
 }
 

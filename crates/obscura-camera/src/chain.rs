@@ -90,7 +90,11 @@ impl PoseCache {
 /// Moves a camera-space ray to world space: the pose applied, the direction renormalised, and
 /// the range rescaled when the pose stretches lengths (so it keeps the same points).
 #[inline]
-fn to_world(pose: &Transform<World, CameraSpace>, parts: CameraRayParts, time: f32) -> Ray<World> {
+pub(crate) fn to_world(
+    pose: &Transform<World, CameraSpace>,
+    parts: CameraRayParts,
+    time: f32,
+) -> Ray<World> {
     let ray = Ray::new(
         Point3::from_glam(parts.origin.as_vec3()),
         Vector3::from_glam(parts.direction.as_vec3()),

@@ -177,6 +177,40 @@ pub enum CameraError {
         /// The number of entries given.
         got: usize,
     },
+    /// A lens prescription that does not parse or describes no usable lens.
+    #[error(
+        "lens prescription{}: {message}",
+        match line { Some(l) => format!(", line {l}"), None => String::new() }
+    )]
+    LensPrescription {
+        /// The 1-based line at fault, when one is.
+        line: Option<usize>,
+        /// What is wrong.
+        message: String,
+    },
+    /// An aperture diameter that is not positive or exceeds the stop's diameter.
+    #[error(
+        "aperture_diameter must be > 0 mm and at most the stop's diameter of {stop} mm, got {got}"
+    )]
+    ApertureDiameter {
+        /// The value given (mm).
+        got: f32,
+        /// The stop's diameter in the prescription (mm).
+        stop: f32,
+    },
+    /// A focus distance the lens cannot focus at (not positive, or closer than its closest
+    /// focus).
+    #[error("focus_distance must be > 0 and beyond the lens's closest focus, got {got}")]
+    FocusDistance {
+        /// The value given (world units).
+        got: f32,
+    },
+    /// A film diagonal that is not positive.
+    #[error("film_diagonal must be > 0 mm, got {got}")]
+    FilmDiagonal {
+        /// The value given (mm).
+        got: f32,
+    },
 }
 
 /// `Ok(x)` when `x` is finite, else the error naming `what`.

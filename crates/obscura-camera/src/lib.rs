@@ -14,7 +14,8 @@
 //!
 //! Beyond the lecture: the ideal fisheyes [`FisheyeCamera`] ([`FisheyeProjection`]), the
 //! panoramas [`CylindricalCamera`], [`OctahedralCamera`] (equal-area) and [`CubeFaceCamera`]
-//! ([`CubeFace`]), and the omni-directional stereo panorama [`OdsCamera`]; each doc comment
+//! ([`CubeFace`]), the omni-directional stereo panorama [`OdsCamera`], and the lens system
+//! [`RealisticCamera`] (a [`LensPrescription`] traced element by element); each doc comment
 //! gives its formulas, its source and the film points from which no ray leaves.
 //!
 //! What is not here: films with pixels, filters, samplers, scene files, geometry. This crate
@@ -81,6 +82,7 @@ mod opencv_fisheye;
 mod orthographic;
 mod perspective;
 mod projective;
+mod realistic;
 mod stereo;
 
 pub use any::AnyCamera;
@@ -103,4 +105,8 @@ pub use opencv_fisheye::{FISHEYE_INVERSE_TOLERANCE_PX, OpenCvFisheyeCamera};
 pub use orthographic::OrthographicCamera;
 pub use perspective::{PerspectiveCamera, validate_fov};
 pub use projective::ProjectiveCamera;
+pub use realistic::{
+    DEFAULT_FILM_DIAGONAL, LensPrescription, LensSurface, MM_PER_UNIT, PROJECT_TOLERANCE_MM,
+    PUPIL_SEGMENTS, RealisticCamera, RealisticLens,
+};
 pub use stereo::{StereoEye, StereoRig};

@@ -437,6 +437,7 @@ fn model_name(c: &AnyCamera) -> &'static str {
         AnyCamera::Ods(_) => "ods",
         AnyCamera::OpenCv(_) => "opencv",
         AnyCamera::OpenCvFisheye(_) => "opencv_fisheye",
+        AnyCamera::Realistic(_) => "realistic",
     }
 }
 

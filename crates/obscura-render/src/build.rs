@@ -13,8 +13,8 @@ use obscura_accel::{Placement, Scene, SceneBuilder, Shape, TriangleMesh};
 use obscura_camera::{
     AnyCamera, CameraBase, CameraError, CubeFaceCamera, CylindricalCamera, EnvironmentCamera,
     FilmGeometry, FisheyeCamera, LookAt, OctahedralCamera, OdsCamera, OpenCvCamera,
-    OpenCvFisheyeCamera, OrthographicCamera, PerspectiveCamera, ScreenWindow, look_at_pose,
-    opencv_pose,
+    OpenCvFisheyeCamera, OrthographicCamera, PerspectiveCamera, RealisticCamera, RealisticLens,
+    ScreenWindow, look_at_pose, opencv_pose,
 };
 use obscura_sample::Sampler;
 use obscura_shade::{EnvironmentLight, Light, Material, ShadingScene};
@@ -334,6 +334,25 @@ pub(crate) fn build_camera(
         CameraKind::Ods => {
             let interaxial = rig.map_or(DEFAULT_INTERAXIAL, |r| r.interaxial);
             OdsCamera::new(base, interaxial)?.into()
+        }
+        CameraKind::Realistic => {
+            // A parsed file always has the lens; a description built in code without one gets
+            // the error a file without rows would.
+            let r = c
+                .realistic
+                .as_ref()
+                .ok_or_else(|| CameraError::LensPrescription {
+                    line: None,
+                    message: "no lens_file".into(),
+                })?;
+            let lens = RealisticLens {
+                aperture_diameter: r.aperture_diameter,
+                focus_distance: r.focus_distance,
+                film_diagonal: r.film_diagonal,
+                blades: c.lens.blades,
+                rotation_degrees: c.lens.rotation_degrees,
+            };
+            RealisticCamera::new(base, &r.prescription, lens)?.into()
         }
     })
 }

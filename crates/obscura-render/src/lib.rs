@@ -77,9 +77,9 @@ pub use render::{
     RenderOptions, RenderOutcome, RenderStats, TILE_SIZE, TILE_WINDOW, render, sample_value, tiles,
 };
 pub use scene::{
-    CameraKind, CameraPose, CameraSettings, DEFAULT_INTERAXIAL, Extrinsics, FilmSettings,
-    FilterSettings, IntegratorKind, IntegratorSettings, LightSettings, MaterialSettings,
-    SamplerSettings, SceneDescription, ShapeGeometry, ShapeSettings, StereoLayout, StereoSettings,
-    load_description, parse_description,
+    CameraKind, CameraPose, CameraSettings, DEFAULT_FOCUS_DISTANCE, DEFAULT_INTERAXIAL, Extrinsics,
+    FilmSettings, FilterSettings, IntegratorKind, IntegratorSettings, LightSettings,
+    MaterialSettings, RealisticSettings, SamplerSettings, SceneDescription, ShapeGeometry,
+    ShapeSettings, StereoLayout, StereoSettings, load_description, parse_description,
 };
 pub use stereo::compose_stereo;

@@ -6,13 +6,21 @@
 
 use super::parse::Cx;
 use super::raw::RawCamera;
-use super::settings::{CameraKind, CameraSettings, Extrinsics, StereoLayout, StereoSettings, V3};
+use super::settings::{
+    CameraKind, CameraSettings, Extrinsics, RealisticSettings, StereoLayout, StereoSettings, V3,
+};
 use crate::error::RenderError;
 use obscura_camera::{
-    CameraError, CubeFace, FisheyeProjection, FovAxis, LookAt, OpenCvIntrinsics, ScreenWindow,
-    Shutter, StereoRig, ThinLens, opencv_pose, validate_clip, validate_fov,
+    CameraError, CubeFace, DEFAULT_FILM_DIAGONAL, FisheyeProjection, FovAxis, LensPrescription,
+    LookAt, OpenCvIntrinsics, ScreenWindow, Shutter, StereoRig, ThinLens, opencv_pose,
+    validate_clip, validate_fov,
 };
 use obscura_space::{Camera as CameraSpace, Point3, SpaceError, Transform, Vector3, World};
+use std::path::Path;
+
+/// The realistic camera's focus distance when the scene gives none (world units, metres):
+/// 10, as pbrt-v4's.
+pub const DEFAULT_FOCUS_DISTANCE: f32 = 10.0;
 
 /// The interaxial distance when `[camera.stereo]` does not give one: 65 mm, a typical adult's
 /// distance between the pupils, in metres.
@@ -38,6 +46,9 @@ pub(crate) fn camera_key(e: &CameraError) -> &'static str {
             "tvec" => "camera.tvec",
             "interaxial" => "camera.stereo.interaxial",
             "convergence" => "camera.stereo.convergence",
+            "aperture_diameter" => "camera.aperture_diameter",
+            "focus_distance" => "camera.focus_distance",
+            "film_diagonal" => "camera.film_diagonal",
             _ => "camera",
         },
         CameraError::Fov { .. } | CameraError::FisheyeFov { .. } => "camera.fov",
@@ -63,6 +74,10 @@ pub(crate) fn camera_key(e: &CameraError) -> &'static str {
             _ => "camera.fx",
         },
         CameraError::DistortionLength { .. } => "camera.distortion",
+        CameraError::LensPrescription { .. } => "camera.lens_file",
+        CameraError::ApertureDiameter { .. } => "camera.aperture_diameter",
+        CameraError::FocusDistance { .. } => "camera.focus_distance",
+        CameraError::FilmDiagonal { .. } => "camera.film_diagonal",
     }
 }
 
@@ -73,8 +88,13 @@ fn reads(kind: CameraKind, key: &str) -> bool {
     match key {
         "fov" => matches!(kind, Perspective | Fisheye | Cylindrical),
         "fov_axis" => kind == Perspective,
-        "screen_window" | "lens_radius" | "focal_distance" | "aperture_blades"
-        | "aperture_rotation" => matches!(kind, Perspective | Orthographic),
+        "screen_window" | "lens_radius" | "focal_distance" => {
+            matches!(kind, Perspective | Orthographic)
+        }
+        "aperture_blades" | "aperture_rotation" => {
+            matches!(kind, Perspective | Orthographic | Realistic)
+        }
+        "lens_file" | "aperture_diameter" | "focus_distance" | "film_diagonal" => kind == Realistic,
         "lens_shift" => matches!(kind, Perspective | Orthographic | Fisheye),
         "fx" | "fy" | "cx" | "cy" | "distortion" => matches!(kind, OpenCv | OpenCvFisheye),
         "projection" => kind == Fisheye,
@@ -93,6 +113,7 @@ impl Cx<'_> {
     pub(super) fn camera(
         &self,
         c: RawCamera,
+        base: &Path,
         ignored: &mut Vec<String>,
     ) -> Result<CameraSettings, RenderError> {
         let name = c.kind.as_deref().unwrap_or("perspective");
@@ -123,6 +144,10 @@ impl Cx<'_> {
             ("projection", c.projection.is_some()),
             ("face", c.face.is_some()),
             ("stereo", c.stereo.is_some()),
+            ("lens_file", c.lens_file.is_some()),
+            ("aperture_diameter", c.aperture_diameter.is_some()),
+            ("focus_distance", c.focus_distance.is_some()),
+            ("film_diagonal", c.film_diagonal.is_some()),
         ];
         for (key, _) in given.iter().filter(|(k, g)| *g && !reads(kind, k)) {
             ignored.push(format!("camera.{key} is ignored by the {name} camera"));
@@ -257,6 +282,16 @@ impl Cx<'_> {
             ));
         }
 
+        let realistic = if kind == CameraKind::Realistic {
+            Some(self.realistic(
+                c.lens_file,
+                [c.aperture_diameter, c.focus_distance, c.film_diagonal],
+                base,
+            )?)
+        } else {
+            None
+        };
+
         // The OpenCV models' intrinsics (pixels) and distortion (checked by the model).
         let opencv = matches!(kind, CameraKind::OpenCv | CameraKind::OpenCvFisheye);
         let intrinsics = match (c.fx, c.fy, c.cx, c.cy) {
@@ -365,6 +400,48 @@ impl Cx<'_> {
             stereo,
             eye: None,
             pose,
+            realistic,
+        })
+    }
+
+    /// The realistic camera's keys: the lens file read (relative to the scene file) and
+    /// parsed, the numbers checked for finiteness (the camera checks the rest when built).
+    /// `numbers` are `aperture_diameter`, `focus_distance` and `film_diagonal`.
+    fn realistic(
+        &self,
+        lens_file: Option<String>,
+        numbers: [Option<f32>; 3],
+        base: &Path,
+    ) -> Result<RealisticSettings, RenderError> {
+        let [aperture_diameter, focus_distance, film_diagonal] = numbers;
+        let Some(file) = lens_file else {
+            return Err(self.err(
+                "camera.lens_file",
+                "a realistic camera needs `lens_file`, a lens prescription (see scenes/lenses/)",
+            ));
+        };
+        let lens_file = base.join(&file);
+        let text = std::fs::read_to_string(&lens_file).map_err(|e| {
+            self.err(
+                "camera.lens_file",
+                format!("cannot read the lens file {}: {e}", lens_file.display()),
+            )
+        })?;
+        let prescription = LensPrescription::parse(&text)
+            .map_err(|e| self.err("camera.lens_file", format!("{}: {e}", lens_file.display())))?;
+        let focus_distance = focus_distance.unwrap_or(DEFAULT_FOCUS_DISTANCE);
+        let film_diagonal = film_diagonal.unwrap_or(DEFAULT_FILM_DIAGONAL);
+        self.finite("camera.focus_distance", &[focus_distance])?;
+        self.finite("camera.film_diagonal", &[film_diagonal])?;
+        if let Some(a) = aperture_diameter {
+            self.finite("camera.aperture_diameter", &[a])?;
+        }
+        Ok(RealisticSettings {
+            lens_file,
+            prescription,
+            aperture_diameter,
+            focus_distance,
+            film_diagonal,
         })
     }
 
@@ -431,6 +508,35 @@ mod tests {
                     got: f32::NAN,
                 },
                 "camera.aperture_rotation",
+            ),
+            (
+                CameraError::LensPrescription {
+                    line: Some(3),
+                    message: "x".into(),
+                },
+                "camera.lens_file",
+            ),
+            (
+                CameraError::ApertureDiameter {
+                    got: 30.0,
+                    stop: 17.1,
+                },
+                "camera.aperture_diameter",
+            ),
+            (
+                CameraError::FocusDistance { got: 0.01 },
+                "camera.focus_distance",
+            ),
+            (
+                CameraError::FilmDiagonal { got: 0.0 },
+                "camera.film_diagonal",
+            ),
+            (
+                CameraError::NonFinite {
+                    what: "focus_distance",
+                    got: f32::NAN,
+                },
+                "camera.focus_distance",
             ),
         ];
         for (e, key) in cases {

@@ -14,11 +14,11 @@ mod parse;
 mod raw;
 mod settings;
 
-pub use camera::DEFAULT_INTERAXIAL;
 pub(crate) use camera::camera_key;
+pub use camera::{DEFAULT_FOCUS_DISTANCE, DEFAULT_INTERAXIAL};
 pub use parse::{load_description, parse_description};
 pub use settings::{
     CameraKind, CameraPose, CameraSettings, Extrinsics, FilmSettings, FilterSettings,
-    IntegratorKind, IntegratorSettings, LightSettings, MaterialSettings, SamplerSettings,
-    SceneDescription, ShapeGeometry, ShapeSettings, StereoLayout, StereoSettings,
+    IntegratorKind, IntegratorSettings, LightSettings, MaterialSettings, RealisticSettings,
+    SamplerSettings, SceneDescription, ShapeGeometry, ShapeSettings, StereoLayout, StereoSettings,
 };

@@ -48,7 +48,7 @@ pub fn parse_description(path: &Path, source: &str) -> Result<SceneDescription, 
     let film = cx.film(raw.film)?;
     let sampler = cx.sampler(raw.sampler)?;
     let integrator = cx.integrator(raw.integrator)?;
-    let camera = cx.camera(raw.camera, &mut ignored)?;
+    let camera = cx.camera(raw.camera, base, &mut ignored)?;
     // What needs the film too (a fisheye's field of view, a square film) is checked by
     // building the camera once.
     crate::build::build_camera(&camera, film.resolution, film.crop)

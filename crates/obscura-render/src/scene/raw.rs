@@ -81,6 +81,10 @@ pub(super) struct RawCamera {
     pub(super) stereo: Option<RawStereo>,
     pub(super) pose: Option<[f32; 16]>,
     pub(super) pose_end: Option<[f32; 16]>,
+    pub(super) lens_file: Option<String>,
+    pub(super) aperture_diameter: Option<f32>,
+    pub(super) focus_distance: Option<f32>,
+    pub(super) film_diagonal: Option<f32>,
 }
 
 #[derive(Deserialize)]

@@ -3,8 +3,8 @@
 use crate::error::RenderError;
 use obscura_accel::TriangleMesh;
 use obscura_camera::{
-    CubeFace, FisheyeProjection, FovAxis, LookAt, OpenCvIntrinsics, ScreenWindow, Shutter,
-    StereoEye, StereoRig, ThinLens,
+    CubeFace, FisheyeProjection, FovAxis, LensPrescription, LookAt, OpenCvIntrinsics, ScreenWindow,
+    Shutter, StereoEye, StereoRig, ThinLens,
 };
 use obscura_sample::SamplerKind;
 use obscura_space::{Camera as CameraSpace, Object, Transform, World};
@@ -204,11 +204,13 @@ pub enum CameraKind {
     CubeFace,
     /// Omni-directional stereo: both eyes' equirectangular panoramas, left on top.
     Ods,
+    /// A lens system traced element by element (`type = "realistic"`, with `lens_file`).
+    Realistic,
 }
 
 impl CameraKind {
     /// Every model, in the order the scene format lists them.
-    pub const ALL: [CameraKind; 10] = [
+    pub const ALL: [CameraKind; 11] = [
         CameraKind::Perspective,
         CameraKind::Orthographic,
         CameraKind::Environment,
@@ -219,6 +221,7 @@ impl CameraKind {
         CameraKind::Octahedral,
         CameraKind::CubeFace,
         CameraKind::Ods,
+        CameraKind::Realistic,
     ];
 
     /// The model's `type` in the scene file.
@@ -234,6 +237,7 @@ impl CameraKind {
             CameraKind::Octahedral => "octahedral",
             CameraKind::CubeFace => "cube_face",
             CameraKind::Ods => "ods",
+            CameraKind::Realistic => "realistic",
         }
     }
 
@@ -329,6 +333,23 @@ pub struct CameraSettings {
     /// `pose` (and `pose_end`): world from camera as matrices, instead of the look-at; any
     /// affine matrix, so also a pose that mirrors the image as pbrt's look-at does.
     pub pose: Option<(CameraPose, Option<CameraPose>)>,
+    /// The realistic camera's lens system and settings (None for the other models).
+    pub realistic: Option<RealisticSettings>,
+}
+
+/// The `[camera]` keys of `type = "realistic"`, with the lens file read and parsed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RealisticSettings {
+    /// `lens_file`, resolved against the scene file's folder.
+    pub lens_file: PathBuf,
+    /// The prescription the file holds.
+    pub prescription: LensPrescription,
+    /// `aperture_diameter` (mm); None for the stop's full diameter.
+    pub aperture_diameter: Option<f32>,
+    /// `focus_distance` (world units, metres), from the film plane.
+    pub focus_distance: f32,
+    /// `film_diagonal` (mm).
+    pub film_diagonal: f32,
 }
 
 impl SceneDescription {
