@@ -66,6 +66,7 @@
 #![deny(missing_docs)]
 
 mod any;
+mod aperture;
 mod camera;
 mod chain;
 mod cube_face;
@@ -81,12 +82,14 @@ mod opencv_fisheye;
 mod orthographic;
 mod perspective;
 mod projective;
+mod shutter;
 mod stereo;
 
 pub use any::AnyCamera;
+pub use aperture::{Aperture, ApertureImage, ApertureShape, MAX_BLADES};
 pub use camera::{
     Camera, CameraBase, CameraRay, CameraRayDifferential, CameraSample, DEFAULT_FAR, DEFAULT_NEAR,
-    LookAt, MAX_BLADES, ThinLens, look_at_pose,
+    LookAt, ThinLens, look_at_pose,
 };
 pub use cube_face::{CubeFace, CubeFaceCamera};
 pub use cylindrical::CylindricalCamera;
@@ -103,4 +106,5 @@ pub use opencv_fisheye::{FISHEYE_INVERSE_TOLERANCE_PX, OpenCvFisheyeCamera};
 pub use orthographic::OrthographicCamera;
 pub use perspective::{PerspectiveCamera, validate_fov};
 pub use projective::ProjectiveCamera;
+pub use shutter::{RollingDirection, RollingShutter, ShutterTiming};
 pub use stereo::{StereoEye, StereoRig};
