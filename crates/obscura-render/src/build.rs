@@ -45,6 +45,9 @@ pub struct RenderScene {
     pub pixel_bounds: PixelRect,
     /// Triangles skipped as degenerate while loading meshes, per file.
     pub skipped_triangles: Vec<(PathBuf, usize)>,
+    /// The factor the path integrator's radiance is scaled by when the camera gives exposure
+    /// settings ([`obscura_camera::Exposure::scale`]); None (no scaling at all) otherwise.
+    pub exposure_scale: Option<f32>,
 }
 
 /// The grey diffuse that shapes without a `material` key get.
@@ -172,6 +175,7 @@ impl RenderScene {
         let sampler = Sampler::new(d.sampler.kind, d.sampler.spp, d.sampler.seed)
             .map_err(|e| d.error("sampler", e.to_string()))?;
         let filter = Filter::new(d.film.filter);
+        let exposure_scale = d.camera.exposure.map(|e| e.scale());
         Ok(RenderScene {
             description,
             camera,
@@ -181,6 +185,7 @@ impl RenderScene {
             filter,
             pixel_bounds,
             skipped_triangles,
+            exposure_scale,
         })
     }
 
@@ -297,7 +302,9 @@ pub(crate) fn build_camera(
         window = Some(w);
     }
     let film = FilmGeometry::new(resolution, window, crop)?;
-    let base = CameraBase::new(pose, c.shutter, film).with_clip(c.near, c.far);
+    let base = CameraBase::new(pose, c.shutter, film)
+        .with_clip(c.near, c.far)
+        .with_timing(c.timing.clone());
     // The OpenCV models always have intrinsics from a parsed file; a description built in code
     // without them gets the error a missing fx would.
     let intrinsics = || {
@@ -307,8 +314,10 @@ pub(crate) fn build_camera(
         })
     };
     Ok(match c.kind {
-        CameraKind::Perspective => PerspectiveCamera::new(base, c.fov, c.fov_axis, c.lens)?.into(),
-        CameraKind::Orthographic => OrthographicCamera::new(base, c.lens)?.into(),
+        CameraKind::Perspective => {
+            PerspectiveCamera::new(base, c.fov, c.fov_axis, c.lens.clone())?.into()
+        }
+        CameraKind::Orthographic => OrthographicCamera::new(base, c.lens.clone())?.into(),
         CameraKind::Environment => EnvironmentCamera::new(base)?.into(),
         CameraKind::OpenCv => OpenCvCamera::new(base, intrinsics()?, &c.distortion)?.into(),
         CameraKind::OpenCvFisheye => {
