@@ -16,6 +16,7 @@ mod motion;
 mod octahedral;
 mod ods;
 mod opencv;
+mod photo;
 mod projective;
 mod ray_checks;
 mod sample_use;
