@@ -4,6 +4,7 @@
 mod cli;
 mod gallery;
 mod opencv;
+mod photo;
 mod robust;
 mod scenes;
 mod views;
