@@ -197,13 +197,14 @@ fn shutter_curve_times_match_the_curve() {
             })
     };
     let bins = 20;
-    let mut mass = vec![0.0f64; bins];
     let fine = 200;
-    for b in 0..bins {
-        for k in 0..fine {
-            mass[b] += openness((b as f64 + (k as f64 + 0.5) / fine as f64) / bins as f64);
-        }
-    }
+    let mass: Vec<f64> = (0..bins)
+        .map(|b| {
+            (0..fine)
+                .map(|k| openness((b as f64 + (k as f64 + 0.5) / fine as f64) / bins as f64))
+                .sum()
+        })
+        .collect();
     let total: f64 = mass.iter().sum();
     let n = 100_000;
     // Stratified time samples: the curve must keep equal-weight strata equal-weight.

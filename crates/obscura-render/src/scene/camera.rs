@@ -445,8 +445,10 @@ impl Cx<'_> {
             ));
         };
         let derived = exposure.lens_radius(focal_length);
+        // NaN never agrees.
+        let agrees = |given: f32| (given - derived).abs() <= 1e-4 * derived;
         if let Some(given) = c.lens_radius
-            && !((given - derived).abs() <= 1e-4 * derived)
+            && !agrees(given)
         {
             return Err(self.camera_err(CameraError::LensRadiusDisagrees {
                 lens_radius: given,
