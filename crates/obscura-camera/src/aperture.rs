@@ -55,8 +55,10 @@ impl ApertureImage {
         [self.width, self.height]
     }
 
-    /// A point of `[-1, 1]^2` drawn in proportion to the weights, from `u` in `[0, 1)^2`.
-    #[inline]
+    /// A point of `[-1, 1]^2` drawn in proportion to the weights, from `u` in `[0, 1)^2`. Out
+    /// of line: it is large, and inlined it would crowd the round and polygonal apertures'
+    /// per-ray path.
+    #[inline(never)]
     fn sample(&self, u: Vec2) -> Vec2 {
         let (uv, _) = self.distribution.sample(u);
         // Image x right -> +x; image row 0 (v = 0) is the top -> +y.
@@ -185,7 +187,7 @@ impl Aperture {
     /// The point of the unit aperture (camera space, plane z = 0, in units of the lens
     /// radius) of a lens sample `u` in `[0, 1)^2`, uniform over the outline's area (in
     /// proportion to the weights for an image), then squeezed.
-    #[inline]
+    #[inline(always)]
     pub fn sample(&self, u: Vec2) -> Vec2 {
         let p = match &self.shape {
             ApertureShape::Circle => obscura_sample::square_to_concentric_disk(u),

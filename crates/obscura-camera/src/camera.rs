@@ -499,10 +499,16 @@ pub(crate) fn ray_time(base: &CameraBase, sample: &CameraSample) -> Option<f32> 
     if base.timing.is_uniform() {
         return Some(base.shutter.time_at(sample.time));
     }
-    Some(
-        base.timing
-            .time(base.shutter, &base.film, sample.p_film, sample.time),
-    )
+    Some(timed_ray_time(base, sample))
+}
+
+/// [`ray_time`] through a shutter curve or rolling shutter: out of line, so that the common
+/// uniform shutter's path stays short.
+#[cold]
+#[inline(never)]
+fn timed_ray_time(base: &CameraBase, sample: &CameraSample) -> f32 {
+    base.timing
+        .time(base.shutter, &base.film, sample.p_film, sample.time)
 }
 
 /// The film points of a differential's three rays: the sample's and its neighbours one pixel
