@@ -17,6 +17,12 @@
 //! ([`CubeFace`]), and the omni-directional stereo panorama [`OdsCamera`]; each doc comment
 //! gives its formulas, its source and the film points from which no ray leaves.
 //!
+//! Photographic controls: an [`Aperture`] (round, blades, an [`ApertureImage`] of weights, an
+//! anamorphic squeeze) is the thin lens's opening, which [`ThinLens`] may also tilt
+//! (Scheimpflug); [`ShutterTiming`] (a piecewise-linear shutter curve, a [`RollingShutter`])
+//! spreads every model's ray times; [`Exposure`] is the f-number, shutter time, ISO and
+//! compensation a renderer scales radiance by.
+//!
 //! What is not here: films with pixels, filters, samplers, scene files, geometry. This crate
 //! knows nothing of BVHs, images or files; it depends on `obscura-space`, `obscura-sample`
 //! (for the aperture warps) and glam.

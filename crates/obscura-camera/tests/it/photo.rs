@@ -282,6 +282,28 @@ fn to_camera(p: obscura_space::Point3<obscura_space::World>) -> Vec3 {
 proptest! {
     #![proptest_config(cases(64))]
 
+    /// Every aperture sample lies in its outline, squeezed: the polygon (or disk) with x
+    /// multiplied back by the squeeze.
+    #[test]
+    fn aperture_samples_stay_inside_the_squeezed_outline(
+        blades in prop_oneof![Just(0u32), 3u32..12],
+        rotation in -360f32..360.0,
+        squeeze in 1f32..3.0,
+        ux in 0f32..1.0, uy in 0f32..1.0,
+    ) {
+        let aperture = Aperture::polygon(blades, rotation)
+            .unwrap()
+            .with_anamorphic(squeeze)
+            .unwrap();
+        let p = aperture.sample(Vec2::new(ux, uy));
+        let unsqueezed = Vec2::new(p.x * squeeze, p.y) * (1.0 - 1e-5);
+        if blades == 0 {
+            prop_assert!(unsqueezed.length() <= 1.0, "{}", p);
+        } else {
+            prop_assert!(in_polygon(unsqueezed, blades, rotation), "{}", p);
+        }
+    }
+
     /// Points on the tilted plane image to a point: every lens sample's ray through a film
     /// point passes through the centre ray's meeting point with the plane. Points off the plane
     /// spread by the thin-lens formula: at depth `z` the ray from lens point `a` is

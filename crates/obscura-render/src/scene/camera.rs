@@ -614,6 +614,24 @@ mod tests {
             ("aperture_blades = 2", "camera.aperture_blades"),
             ("aperture_blades = 65", "camera.aperture_blades"),
             ("shutter = [1.0, 0.0]", "camera.shutter"),
+            ("anamorphic = 0.5", "camera.anamorphic"),
+            (
+                "shutter_curve = [[0.5, 1.0], [0.2, 1.0]]",
+                "camera.shutter_curve",
+            ),
+            (
+                "rolling_shutter = { readout = 2.0 }",
+                "camera.rolling_shutter",
+            ),
+            ("focal_plane_tilt = [5.0, 0.0]", "camera.focal_plane_tilt"),
+            ("f_number = -2.0", "camera.f_number"),
+            ("iso = 0.0", "camera.iso"),
+            ("shutter_time = 0.0", "camera.shutter_time"),
+            (
+                "exposure_compensation = 500.0",
+                "camera.exposure_compensation",
+            ),
+            ("focal_length = 0.05", "camera.focal_length"),
             (
                 "screen_window = [1.0, -1.0, -1.0, 1.0]",
                 "camera.screen_window",
