@@ -5,9 +5,10 @@
 //! cargo run --release --example gallery -- [--quick] [OUT_DIR]     # OUT_DIR: docs/gallery
 //! ```
 //!
-//! `--quick` makes tiny, noisy pictures in seconds (what the tests run).
+//! `--quick` makes tiny, noisy pictures in seconds (what the tests run); `--only NAME` (repeatable)
+//! makes just the named figures.
 
-use camera_obscura::gallery::{Quality, generate};
+use camera_obscura::gallery::{Quality, generate_only};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -15,9 +16,18 @@ use std::time::Instant;
 fn main() -> ExitCode {
     let mut quality = Quality::Full;
     let mut out_dir = None;
-    for arg in std::env::args().skip(1) {
+    let mut only: Vec<String> = Vec::new();
+    let mut args = std::env::args().skip(1);
+    while let Some(arg) = args.next() {
         match arg.as_str() {
             "--quick" => quality = Quality::Quick,
+            "--only" => match args.next() {
+                Some(name) => only.push(name),
+                None => {
+                    eprintln!("error: --only needs a figure name");
+                    return ExitCode::from(2);
+                }
+            },
             "-h" | "--help" => {
                 println!("usage: gallery [--quick] [OUT_DIR]   (OUT_DIR defaults to docs/gallery)");
                 return ExitCode::SUCCESS;
@@ -36,7 +46,8 @@ fn main() -> ExitCode {
     let out_dir = out_dir.unwrap_or_else(|| PathBuf::from("docs/gallery"));
     let start = Instant::now();
     let mut last = Instant::now();
-    let result = generate(&out_dir, quality, |made| {
+    let only: Vec<&str> = only.iter().map(String::as_str).collect();
+    let result = generate_only(&out_dir, quality, &only, |made| {
         println!(
             "{} ({}x{}, {:.1} s)",
             made.png.display(),

@@ -5,7 +5,10 @@
 //! rendered once or several times with parameters varied, the panels laid side by side into one
 //! opaque PNG of the same name. [`generate`] does it all; [`FIGURES`] names what it makes.
 
-use obscura_camera::{CubeFace, FisheyeProjection, LensPrescription, OpenCvIntrinsics};
+use obscura_camera::{
+    Aperture, CubeFace, FisheyeProjection, LensPrescription, OpenCvIntrinsics, Shutter,
+    ShutterTiming,
+};
 use obscura_render::{
     DepthOfField, Image, ImageInfo, RenderError, RenderOptions, RenderScene, SceneDescription,
     compose_stereo, depth_of_field, motion_blur, parse_description, render, screen_buffers,
@@ -58,7 +61,7 @@ macro_rules! figure {
 }
 
 /// Every figure the gallery makes, in order.
-pub const FIGURES: [Figure; 21] = [
+pub const FIGURES: [Figure; 24] = [
     figure!("projection-perspective"),
     figure!("projection-orthographic"),
     figure!("dof-lens-radius"),
@@ -80,6 +83,9 @@ pub const FIGURES: [Figure; 21] = [
     figure!("ods"),
     figure!("lens-shift"),
     figure!("realistic-lenses"),
+    figure!("aperture-bokeh"),
+    figure!("rolling-shutter"),
+    figure!("tilt-shift"),
 ];
 
 /// The `realistic-lenses` row: each lens file (written into `lenses/` beside the scene), its
@@ -102,6 +108,13 @@ pub const LENS_PANELS: [(&str, &str, f32); 3] = [
         2.5,
     ),
 ];
+
+/// The aperture image the `aperture-bokeh` figure reads, written beside its scene.
+pub const APERTURE_IMAGE: &str = "aperture-star.png";
+
+/// The `tilt-shift` row: the focal plane's tilt about camera x in each panel (the camera looks
+/// down at 32.47 degrees, so 57.53 lays the plane in the ground).
+pub const TILT_PANELS: [f32; 3] = [0.0, 57.53, -57.53];
 
 /// The `fisheye-projections` row: each projection and its field of view in degrees (the
 /// orthographic fisheye cannot reach 90 degrees off its axis).
@@ -137,6 +150,16 @@ pub struct Made {
 pub fn generate(
     out_dir: &Path,
     quality: Quality,
+    on_figure: impl FnMut(&Made),
+) -> Result<Vec<Made>, RenderError> {
+    generate_only(out_dir, quality, &[], on_figure)
+}
+
+/// [`generate`] for the figures named in `only` (all of them when it is empty).
+pub fn generate_only(
+    out_dir: &Path,
+    quality: Quality,
+    only: &[&str],
     mut on_figure: impl FnMut(&Made),
 ) -> Result<Vec<Made>, RenderError> {
     std::fs::create_dir_all(out_dir).map_err(|source| RenderError::Io {
@@ -144,8 +167,12 @@ pub fn generate(
         action: "cannot create the folder",
         source,
     })?;
+    write_aperture_star(&out_dir.join(APERTURE_IMAGE))?;
     let mut made = Vec::new();
     for figure in FIGURES {
+        if !only.is_empty() && !only.contains(&figure.name) {
+            continue;
+        }
         let m = make_figure(out_dir, figure, quality)?;
         on_figure(&m);
         made.push(m);
@@ -289,6 +316,40 @@ fn make_figure(out_dir: &Path, figure: Figure, quality: Quality) -> Result<Made,
                 shoot(d)
             })
             .collect::<Result<_, _>>()?,
+        "aperture-bokeh" => {
+            // The panels' apertures are constants, valid by construction.
+            let with = |aperture: Aperture| {
+                let mut d = base.clone();
+                d.camera.lens.aperture = aperture;
+                d
+            };
+            let hexagon = Aperture::polygon(6, 0.0).expect("six blades are valid");
+            let oval = Aperture::CIRCLE
+                .with_anamorphic(1.8)
+                .expect("a squeeze of 1.8 is valid");
+            vec![
+                shoot(with(Aperture::CIRCLE))?,
+                shoot(with(hexagon))?,
+                shoot(base.clone())?,
+                shoot(with(oval))?,
+            ]
+        }
+        "rolling-shutter" => {
+            let mut instant = base.clone();
+            instant.camera.shutter = Shutter::new(0.0, 0.0).expect("an instant is a shutter");
+            instant.camera.timing = ShutterTiming::default();
+            let mut global = base.clone();
+            global.camera.timing = ShutterTiming::default();
+            vec![shoot(instant)?, shoot(global)?, shoot(base)?]
+        }
+        "tilt-shift" => TILT_PANELS
+            .iter()
+            .map(|&tilt| {
+                let mut d = base.clone();
+                d.camera.lens.focal_plane_tilt = [tilt, 0.0];
+                shoot(d)
+            })
+            .collect::<Result<_, _>>()?,
         "postprocess-dof" | "postprocess-motion" => {
             let (distributed, post) = compare(base, figure.name == "postprocess-dof")?;
             let diff = difference(&distributed, &post);
@@ -312,6 +373,63 @@ fn make_figure(out_dir: &Path, figure: Figure, quality: Quality) -> Result<Made,
         size: [row.width, row.height],
         hot_cells,
     })
+}
+
+/// Writes the `aperture-bokeh` figure's aperture: a white five-pointed star on black, 64 x 64,
+/// its edges anti-aliased by 4 x 4 supersampling.
+fn write_aperture_star(path: &Path) -> Result<(), RenderError> {
+    const SIZE: u32 = 64;
+    // A point is inside the star when it is inside the pentagon of its sector's two tips and
+    // the notch between them: test against the star's ten edges as a polygon by winding.
+    let vertices: Vec<[f32; 2]> = (0..10)
+        .map(|k| {
+            let radius = if k % 2 == 0 { 0.95 } else { 0.4 };
+            let angle = std::f32::consts::FRAC_PI_2 + std::f32::consts::PI * k as f32 / 5.0;
+            [radius * angle.cos(), radius * angle.sin()]
+        })
+        .collect();
+    let inside = |x: f32, y: f32| {
+        // Even-odd rule over the star's edges.
+        let mut inside = false;
+        for k in 0..vertices.len() {
+            let [x0, y0] = vertices[k];
+            let [x1, y1] = vertices[(k + 1) % vertices.len()];
+            if (y0 > y) != (y1 > y) && x < x0 + (y - y0) * (x1 - x0) / (y1 - y0) {
+                inside = !inside;
+            }
+        }
+        inside
+    };
+    let mut pixels = Vec::with_capacity((SIZE * SIZE) as usize);
+    for row in 0..SIZE {
+        for col in 0..SIZE {
+            let mut covered = 0.0;
+            for sy in 0..4 {
+                for sx in 0..4 {
+                    // Image x right, image up = +y (row 0 at the top).
+                    let x = -1.0 + 2.0 * (col as f32 + (sx as f32 + 0.5) / 4.0) / SIZE as f32;
+                    let y = 1.0 - 2.0 * (row as f32 + (sy as f32 + 0.5) / 4.0) / SIZE as f32;
+                    if inside(x, y) {
+                        covered += 1.0 / 16.0;
+                    }
+                }
+            }
+            pixels.push([covered, covered, covered, 1.0]);
+        }
+    }
+    let image = Image {
+        width: SIZE,
+        height: SIZE,
+        pixels,
+    };
+    write_image(
+        path,
+        &image,
+        &ImageInfo {
+            partial: false,
+            samples_per_pixel: 0,
+        },
+    )
 }
 
 /// Renders a description with every core and returns its image made opaque: the sky's

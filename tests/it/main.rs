@@ -5,6 +5,7 @@ mod cli;
 mod gallery;
 mod import;
 mod opencv;
+mod photo;
 mod py_fixture;
 mod realistic;
 mod robust;

@@ -46,7 +46,7 @@ fn cameras(moving: bool) -> Vec<(String, AnyCamera)> {
         ),
         (
             format!("perspective lens{suffix}"),
-            PerspectiveCamera::new(base(), 45.0, FovAxis::Smaller, lens)
+            PerspectiveCamera::new(base(), 45.0, FovAxis::Smaller, lens.clone())
                 .unwrap()
                 .into(),
         ),

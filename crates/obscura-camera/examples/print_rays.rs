@@ -34,7 +34,7 @@ fn main() -> Result<(), CameraError> {
         ),
         (
             "perspective, fov 45, lens radius 0.1 focused at 5",
-            PerspectiveCamera::new(base(None)?, 45.0, FovAxis::Smaller, lens)?.into(),
+            PerspectiveCamera::new(base(None)?, 45.0, FovAxis::Smaller, lens.clone())?.into(),
         ),
         (
             "orthographic, window 4 x 3 (pinhole)",

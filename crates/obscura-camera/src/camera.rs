@@ -1,8 +1,10 @@
 //! The `Camera` trait, the samples it takes and the rays it gives, and what all models share:
 //! the pose, the shutter, the film and the clip range.
 
+use crate::aperture::Aperture;
 use crate::error::{CameraError, finite};
 use crate::film::{FilmGeometry, Shutter, validate_clip};
+use crate::shutter::ShutterTiming;
 use glam::DVec3;
 use obscura_sample::SampleStream;
 use obscura_space::{
@@ -144,21 +146,26 @@ pub trait Camera: Send + Sync {
     }
 }
 
-/// The most aperture blades a [`ThinLens`] takes (more is indistinguishable from round).
-pub const MAX_BLADES: u32 = 64;
-
-/// A thin lens: the aperture radius, the distance of the plane in focus, and the aperture's
-/// shape.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// A thin lens: the aperture radius, the distance of the plane in focus, the aperture's
+/// shape, and (perspective only) the tilt of the plane of focus.
+///
+/// With a tilt `[a, b]` (degrees about camera x, then y) the plane of focus is
+/// `z = focal_distance + y tan(a) + x tan(b)` in camera space (Scheimpflug): the plane
+/// `z = focal_distance` turned by `a` about the x-parallel line through `(0, 0,
+/// focal_distance)` and by `b` about the y-parallel one. A positive `a` moves its top away
+/// from the camera (a table top seen from above is sharp front to back), a positive `b` its
+/// right side.
+#[derive(Debug, Clone, PartialEq)]
 pub struct ThinLens {
     /// Aperture radius in camera-space units; 0 is a pinhole.
     pub radius: f32,
-    /// Camera-space z of the plane in perfect focus; > 0.
+    /// Camera-space z of the plane in perfect focus (on the optical axis, when tilted); > 0.
     pub focal_distance: f32,
-    /// Aperture blades: 0 for a round aperture, else 3 to [`MAX_BLADES`] (a regular polygon).
-    pub blades: u32,
-    /// Rotation of the polygonal aperture in degrees, counter-clockwise from camera +x.
-    pub rotation_degrees: f32,
+    /// The aperture's shape in units of the radius.
+    pub aperture: Aperture,
+    /// The plane of focus's tilt in degrees about camera x and camera y, each in (-90, 90);
+    /// `[0, 0]` for none.
+    pub focal_plane_tilt: [f32; 2],
 }
 
 impl ThinLens {
@@ -166,8 +173,8 @@ impl ThinLens {
     pub const PINHOLE: ThinLens = ThinLens {
         radius: 0.0,
         focal_distance: 1.0,
-        blades: 0,
-        rotation_degrees: 0.0,
+        aperture: Aperture::CIRCLE,
+        focal_plane_tilt: [0.0, 0.0],
     };
 
     /// A round thin lens. Errors as [`ThinLens::validate`].
@@ -184,21 +191,37 @@ impl ThinLens {
     /// The same lens with a polygonal aperture of `blades` blades rotated by `rotation_degrees`
     /// (0 blades for round). Errors as [`ThinLens::validate`].
     pub fn with_blades(self, blades: u32, rotation_degrees: f32) -> Result<ThinLens, CameraError> {
+        let aperture = Aperture {
+            anamorphic: self.aperture.anamorphic,
+            ..Aperture::polygon(blades, rotation_degrees)?
+        };
+        self.with_aperture(aperture)
+    }
+
+    /// The same lens with another aperture. Errors as [`ThinLens::validate`].
+    pub fn with_aperture(self, aperture: Aperture) -> Result<ThinLens, CameraError> {
+        let lens = ThinLens { aperture, ..self };
+        lens.validate()?;
+        Ok(lens)
+    }
+
+    /// The same lens with its plane of focus tilted by `degrees` about camera x and y (see
+    /// [`ThinLens`]). Errors as [`ThinLens::validate`].
+    pub fn with_tilt(self, degrees: [f32; 2]) -> Result<ThinLens, CameraError> {
         let lens = ThinLens {
-            blades,
-            rotation_degrees,
+            focal_plane_tilt: degrees,
             ..self
         };
         lens.validate()?;
         Ok(lens)
     }
 
-    /// Checks the parameters: finite numbers, `radius >= 0`, `focal_distance > 0`, `blades` 0
-    /// or 3 to [`MAX_BLADES`].
+    /// Checks the parameters: finite numbers, `radius >= 0`, `focal_distance > 0`, a valid
+    /// aperture ([`Aperture::validate`]), tilt angles in (-90, 90) degrees, and no tilt on a
+    /// pinhole.
     pub fn validate(&self) -> Result<(), CameraError> {
         finite("lens_radius", self.radius)?;
         finite("focal_distance", self.focal_distance)?;
-        finite("aperture rotation", self.rotation_degrees)?;
         if self.radius < 0.0 {
             return Err(CameraError::LensRadius { got: self.radius });
         }
@@ -207,8 +230,13 @@ impl ThinLens {
                 got: self.focal_distance,
             });
         }
-        if self.blades == 1 || self.blades == 2 || self.blades > MAX_BLADES {
-            return Err(CameraError::Blades { got: self.blades });
+        self.aperture.validate()?;
+        let tilt = self.focal_plane_tilt;
+        if !tilt.iter().all(|a| a.is_finite() && a.abs() < 90.0) {
+            return Err(CameraError::FocalPlaneTilt { got: tilt });
+        }
+        if self.is_tilted() && !self.is_thin_lens() {
+            return Err(CameraError::TiltWithoutLens);
         }
         Ok(())
     }
@@ -219,16 +247,37 @@ impl ThinLens {
         self.radius > 0.0
     }
 
+    /// True when the plane of focus is tilted.
+    #[inline]
+    pub fn is_tilted(&self) -> bool {
+        self.focal_plane_tilt != [0.0, 0.0]
+    }
+
+    /// The tilted plane's slopes `(tan(b), tan(a))`: camera z on the plane of focus grows by
+    /// these per unit of camera x and y.
+    pub fn tilt_slopes(&self) -> glam::Vec2 {
+        let [a, b] = self
+            .focal_plane_tilt
+            .map(|d| f64::from(d).to_radians().tan() as f32);
+        glam::Vec2::new(b, a)
+    }
+
+    /// The camera-space z at which the ray through the lens centre with camera-space
+    /// direction `(x, y, 1)` meets the plane of focus: `focal_distance` untilted, else
+    /// `focal_distance / (1 - x tan(b) - y tan(a))`, or None when that ray never meets the
+    /// plane in front of the lens (it is then in focus at infinity).
+    #[inline]
+    pub fn focus_depth(&self, slopes: glam::Vec2, x: f32, y: f32) -> Option<f32> {
+        let denominator = 1.0 - x * slopes.x - y * slopes.y;
+        let z = self.focal_distance / denominator;
+        (denominator > 0.0 && z.is_finite()).then_some(z)
+    }
+
     /// The point of the aperture (camera space, on the plane z = 0) of a lens sample in
-    /// `[0, 1)^2`: the concentric disk, or the regular polygon, scaled by the radius.
+    /// `[0, 1)^2`: [`Aperture::sample`] scaled by the radius.
     #[inline]
     pub fn aperture_point(&self, u: glam::Vec2) -> glam::Vec2 {
-        let unit = if self.blades >= 3 {
-            obscura_sample::square_to_polygon(u, self.blades, self.rotation_degrees)
-        } else {
-            obscura_sample::square_to_concentric_disk(u)
-        };
-        self.radius * unit
+        self.radius * self.aperture.sample(u)
     }
 }
 
@@ -252,6 +301,8 @@ pub struct CameraBase {
     pub near: f32,
     /// Far clip (> near, finite; [`DEFAULT_FAR`] for "none").
     pub far: f32,
+    /// How ray times spread over the shutter: curve and rolling shutter (uniform by default).
+    pub timing: ShutterTiming,
 }
 
 impl CameraBase {
@@ -267,7 +318,14 @@ impl CameraBase {
             film,
             near: DEFAULT_NEAR,
             far: DEFAULT_FAR,
+            timing: ShutterTiming::default(),
         }
+    }
+
+    /// The same base with a shutter curve or rolling shutter (checked by the camera
+    /// constructors).
+    pub fn with_timing(self, timing: ShutterTiming) -> CameraBase {
+        CameraBase { timing, ..self }
     }
 
     /// The same base with the clip range `[near, far]` (checked by the camera constructors).
@@ -287,6 +345,7 @@ impl CameraBase {
             return Err(CameraError::ProjectivePose);
         }
         Shutter::new(self.shutter.open, self.shutter.close)?;
+        self.timing.validate(self.shutter)?;
         validate_clip(self.near, self.far, positive_near)
     }
 
@@ -430,14 +489,27 @@ fn sample_is_finite(sample: &CameraSample) -> bool {
     (v * 0.0).element_sum() + sample.time * 0.0 == 0.0
 }
 
-/// The time of a sample's ray on `shutter`, or None when a number of the sample is not finite
-/// (such a sample gives no ray): the first step of every model's `generate_ray`.
+/// The time of a sample's ray on the base's shutter (through its curve and rolling shutter,
+/// when it has them), or None when a number of the sample is not finite (such a sample gives
+/// no ray): the first step of every model's `generate_ray`.
 #[inline]
-pub(crate) fn ray_time(shutter: Shutter, sample: &CameraSample) -> Option<f32> {
+pub(crate) fn ray_time(base: &CameraBase, sample: &CameraSample) -> Option<f32> {
     if !sample_is_finite(sample) {
         return None;
     }
-    Some(shutter.time_at(sample.time))
+    if base.timing.is_uniform() {
+        return Some(base.shutter.time_at(sample.time));
+    }
+    Some(timed_ray_time(base, sample))
+}
+
+/// [`ray_time`] through a shutter curve or rolling shutter: out of line, so that the common
+/// uniform shutter's path stays short.
+#[cold]
+#[inline(never)]
+fn timed_ray_time(base: &CameraBase, sample: &CameraSample) -> f32 {
+    base.timing
+        .time(base.shutter, &base.film, sample.p_film, sample.time)
 }
 
 /// The film points of a differential's three rays: the sample's and its neighbours one pixel
@@ -463,6 +535,7 @@ pub(crate) fn differential_at(time: f32, rays: [Ray<World>; 3]) -> CameraRayDiff
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::MAX_BLADES;
 
     #[test]
     fn lens_validation() {
@@ -480,11 +553,11 @@ mod tests {
             Err(CameraError::NonFinite { .. })
         ));
         let lens = ThinLens::new(0.1, 2.0).unwrap();
-        assert!(lens.with_blades(2, 0.0).is_err());
-        assert!(lens.with_blades(6, 15.0).is_ok());
-        assert!(lens.with_blades(MAX_BLADES, 0.0).is_ok());
+        assert!(lens.clone().with_blades(2, 0.0).is_err());
+        assert!(lens.clone().with_blades(6, 15.0).is_ok());
+        assert!(lens.clone().with_blades(MAX_BLADES, 0.0).is_ok());
         assert!(matches!(
-            lens.with_blades(MAX_BLADES + 1, 0.0),
+            lens.clone().with_blades(MAX_BLADES + 1, 0.0),
             Err(CameraError::Blades { .. })
         ));
     }
@@ -492,7 +565,7 @@ mod tests {
     #[test]
     fn aperture_points_stay_inside_the_radius() {
         let lens = ThinLens::new(0.5, 1.0).unwrap();
-        let hex = lens.with_blades(6, 0.0).unwrap();
+        let hex = lens.clone().with_blades(6, 0.0).unwrap();
         for i in 0..16 {
             for j in 0..16 {
                 let u = glam::Vec2::new(i as f32 / 16.0, j as f32 / 16.0);

@@ -126,7 +126,7 @@ pub(crate) fn generate(
     ray_at: impl Fn(Point2<Raster>) -> Option<CameraRayParts>,
 ) -> Option<CameraRay> {
     // A finite sample, and its time on the shutter.
-    let time = ray_time(base.shutter, sample)?;
+    let time = ray_time(base, sample)?;
     // The model's camera-space ray (None: no ray leaves this film point), clip range included.
     let parts = ray_at(sample.p_film)?;
     // World space through the pose at that time.
@@ -147,7 +147,7 @@ pub(crate) fn generate_differential(
     ray_at: impl Fn(Point2<Raster>) -> Option<CameraRayParts>,
 ) -> Option<CameraRayDifferential> {
     // A finite sample, and its time on the shutter.
-    let time = ray_time(base.shutter, sample)?;
+    let time = ray_time(base, sample)?;
     // The main camera-space ray and the two neighbours.
     let p = sample.p_film;
     let main = ray_at(p)?;

@@ -149,7 +149,7 @@ impl Camera for EnvironmentCamera {
 
     #[inline]
     fn generate_ray(&self, sample: &CameraSample) -> Option<CameraRay> {
-        let time = ray_time(self.base.shutter, sample)?;
+        let time = ray_time(&self.base, sample)?;
         // The call in each arm (not through one merged cache reference) lets LLVM keep the
         // fixed cache's fields where they are.
         let mut ray = match &self.fixed {
@@ -162,7 +162,7 @@ impl Camera for EnvironmentCamera {
 
     #[inline]
     fn generate_ray_differential(&self, sample: &CameraSample) -> Option<CameraRayDifferential> {
-        let time = ray_time(self.base.shutter, sample)?;
+        let time = ray_time(&self.base, sample)?;
         // As in generate_ray: the call in each arm keeps the fixed cache read in place.
         Some(match &self.fixed {
             Some(cache) => self.differential(cache, sample, time),

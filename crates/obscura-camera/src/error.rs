@@ -65,6 +65,67 @@ pub enum CameraError {
         /// The value given.
         got: u32,
     },
+    /// An aperture image that cannot be sampled.
+    #[error("aperture_image: {reason}")]
+    ApertureImage {
+        /// What is wrong with it.
+        reason: String,
+    },
+    /// An anamorphic squeeze below 1.
+    #[error("anamorphic must be >= 1 (the horizontal squeeze of the aperture), got {got}")]
+    Anamorphic {
+        /// The value given.
+        got: f32,
+    },
+    /// A shutter curve that is not a density over the shutter interval.
+    #[error("{0}")]
+    ShutterCurve(String),
+    /// A rolling-shutter readout that is negative or longer than the shutter interval.
+    #[error(
+        "rolling_shutter readout must be in [0, close - open] = [0, {interval}] seconds (the rows' windows lie inside the shutter interval), got {readout}"
+    )]
+    RollingReadout {
+        /// The readout given.
+        readout: f32,
+        /// The shutter interval's length.
+        interval: f32,
+    },
+    /// An unknown rolling-shutter direction.
+    #[error(
+        "rolling_shutter direction must be one of \"top_to_bottom\", \"bottom_to_top\", \"left_to_right\", \"right_to_left\", got {0:?}"
+    )]
+    UnknownRollingDirection(String),
+    /// A focal-plane tilt outside (-90, 90) degrees.
+    #[error("focal_plane_tilt angles must be in (-90, 90) degrees, got [{}, {}]", got[0], got[1])]
+    FocalPlaneTilt {
+        /// The angles given, about camera x then y.
+        got: [f32; 2],
+    },
+    /// A focal-plane tilt on a camera that cannot tilt it.
+    #[error(
+        "focal_plane_tilt needs a perspective camera with a thin lens (lens_radius > 0): a pinhole or another model has no plane of focus to tilt"
+    )]
+    TiltWithoutLens,
+    /// An exposure setting out of range.
+    #[error("{what} must be {need}, got {got}")]
+    Exposure {
+        /// The key, e.g. `"f_number"`.
+        what: &'static str,
+        /// What would be accepted.
+        need: &'static str,
+        /// The value given.
+        got: f32,
+    },
+    /// `lens_radius` given together with `focal_length` and `f_number`, disagreeing.
+    #[error(
+        "lens_radius = {lens_radius} disagrees with focal_length / (2 f_number) = {derived}: give one or the other"
+    )]
+    LensRadiusDisagrees {
+        /// The radius given.
+        lens_radius: f32,
+        /// The radius the focal length and f-number give.
+        derived: f32,
+    },
     /// A zero width or height.
     #[error("resolution must be at least 1 x 1 pixels, got {} x {}", got[0], got[1])]
     Resolution {

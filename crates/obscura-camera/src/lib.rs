@@ -18,6 +18,12 @@
 //! [`RealisticCamera`] (a [`LensPrescription`] traced element by element); each doc comment
 //! gives its formulas, its source and the film points from which no ray leaves.
 //!
+//! Photographic controls: an [`Aperture`] (round, blades, an [`ApertureImage`] of weights, an
+//! anamorphic squeeze) is the thin lens's opening, which [`ThinLens`] may also tilt
+//! (Scheimpflug); [`ShutterTiming`] (a piecewise-linear shutter curve, a [`RollingShutter`])
+//! spreads every model's ray times; [`Exposure`] is the f-number, shutter time, ISO and
+//! compensation a renderer scales radiance by.
+//!
 //! What is not here: films with pixels, filters, samplers, scene files, geometry. This crate
 //! knows nothing of BVHs, images or files; it depends on `obscura-space`, `obscura-sample`
 //! (for the aperture warps) and glam.
@@ -67,12 +73,14 @@
 #![deny(missing_docs)]
 
 mod any;
+mod aperture;
 mod camera;
 mod chain;
 mod cube_face;
 mod cylindrical;
 mod environment;
 mod error;
+mod exposure;
 mod film;
 mod fisheye;
 mod octahedral;
@@ -83,17 +91,20 @@ mod orthographic;
 mod perspective;
 mod projective;
 mod realistic;
+mod shutter;
 mod stereo;
 
 pub use any::AnyCamera;
+pub use aperture::{Aperture, ApertureImage, ApertureShape, MAX_BLADES};
 pub use camera::{
     Camera, CameraBase, CameraRay, CameraRayDifferential, CameraSample, DEFAULT_FAR, DEFAULT_NEAR,
-    LookAt, MAX_BLADES, ThinLens, look_at_pose,
+    LookAt, ThinLens, look_at_pose,
 };
 pub use cube_face::{CubeFace, CubeFaceCamera};
 pub use cylindrical::CylindricalCamera;
 pub use environment::EnvironmentCamera;
 pub use error::CameraError;
+pub use exposure::{Exposure, ISO_CALIBRATION};
 pub use film::{FilmGeometry, FovAxis, MAX_RESOLUTION, ScreenWindow, Shutter, validate_clip};
 pub use fisheye::{FisheyeCamera, FisheyeProjection};
 pub use octahedral::OctahedralCamera;
@@ -109,4 +120,5 @@ pub use realistic::{
     DEFAULT_FILM_DIAGONAL, LensPrescription, LensSurface, MM_PER_UNIT, PROJECT_TOLERANCE_MM,
     PUPIL_SEGMENTS, RealisticCamera, RealisticLens,
 };
+pub use shutter::{RollingDirection, RollingShutter, ShutterTiming};
 pub use stereo::{StereoEye, StereoRig};

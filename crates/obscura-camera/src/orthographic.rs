@@ -64,6 +64,10 @@ impl OrthographicCamera {
     /// An orthographic camera. Errors: non-finite numbers, `near < 0`, `near >= far`, a bad
     /// shutter or lens (see [`ThinLens::validate`]).
     pub fn new(base: CameraBase, lens: ThinLens) -> Result<OrthographicCamera, CameraError> {
+        // Only the perspective thin lens tilts its plane of focus.
+        if lens.is_tilted() {
+            return Err(CameraError::TiltWithoutLens);
+        }
         base.validate(false)?;
         let (n, f) = (f64::from(base.near), f64::from(base.far));
         let screen_from_camera = from_rows([
@@ -98,7 +102,7 @@ impl OrthographicCamera {
     }
     /// The lens.
     #[inline]
-    pub fn lens(&self) -> ThinLens {
+    pub fn lens(&self) -> &ThinLens {
         self.projective.lens()
     }
 }
@@ -201,7 +205,7 @@ impl Camera for OrthographicCamera {
 
     #[inline]
     fn generate_ray(&self, sample: &CameraSample) -> Option<CameraRay> {
-        let time = ray_time(self.shutter(), sample)?;
+        let time = ray_time(self.base(), sample)?;
         // The call in each arm (not through one merged cache reference) lets LLVM keep the
         // fixed cache's fields where they are.
         let mut ray = match &self.fixed {
@@ -218,7 +222,7 @@ impl Camera for OrthographicCamera {
 
     #[inline]
     fn generate_ray_differential(&self, sample: &CameraSample) -> Option<CameraRayDifferential> {
-        let time = ray_time(self.shutter(), sample)?;
+        let time = ray_time(self.base(), sample)?;
         // As in generate_ray: the call in each arm keeps the fixed cache read in place.
         Some(match &self.fixed {
             Some(cache) => self.differential(cache, sample, time),

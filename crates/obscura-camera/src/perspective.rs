@@ -37,6 +37,8 @@ pub struct PerspectiveCamera {
     plane_from_raster: (Vec3A, Vec3A),
     /// The pose cache of a fixed pose, computed once; None when the pose moves.
     fixed: Option<PerspectiveCache>,
+    /// The tilted plane of focus's slopes ([`ThinLens::tilt_slopes`]); None untilted.
+    tilt: Option<Vec2>,
 }
 
 /// The per-pose cache of [`PerspectiveCamera::ray`]: the pose's linear part `R` (its columns,
@@ -114,9 +116,11 @@ impl PerspectiveCamera {
             [0.0, 0.0, 0.0, 1.0],
             [0.0, 0.0, 1.0 / f - 1.0 / n, 1.0 / n],
         ]);
+        let tilt = lens.is_tilted().then(|| lens.tilt_slopes());
         let projective =
             ProjectiveCamera::build(base, lens, (screen_from_camera, camera_from_screen), true)?;
         Ok(PerspectiveCamera {
+            tilt,
             plane_from_raster: projective.film_map(1.0 / scale),
             fixed: projective.base().fixed_frame().map(|f| Self::cache(&f)),
             projective,
@@ -142,7 +146,7 @@ impl PerspectiveCamera {
     }
     /// The lens.
     #[inline]
-    pub fn lens(&self) -> ThinLens {
+    pub fn lens(&self) -> &ThinLens {
         self.projective.lens()
     }
 }
@@ -188,16 +192,25 @@ impl PerspectiveCamera {
                 t_max: base.far * length,
             };
         }
-        // Lens: the centre ray reaches the plane of focus at eye + focal_distance * R q; the
-        // sample ray goes there from the lens point eye + R (a.x, a.y, 0), along
-        // R (focal_distance q - a).
+        // Lens: the centre ray reaches the plane of focus at depth z (focal_distance, or
+        // where it meets the tilted plane) at eye + z R q; the sample ray goes there from
+        // the lens point eye + R (a.x, a.y, 0), along R (z q - a).
         let a = lens.aperture_point(u_lens);
         let offset = cache.lens_x * a.x + cache.lens_y * a.y;
-        let v = w * lens.focal_distance - offset;
-        // Clip: that direction has camera z focal_distance, so camera z = near is at distance
-        // near * len / focal_distance along the unit direction.
+        let focus = match self.tilt {
+            None => Some(lens.focal_distance),
+            Some(slopes) => lens.focus_depth(slopes, q.x, q.y),
+        };
+        let (v, focus) = match focus {
+            Some(z) => (w * z - offset, z),
+            // The centre ray never meets the tilted plane in front: in focus at infinity,
+            // every lens point's ray parallel to it (camera z 1 per unit of R q).
+            None => (w, 1.0),
+        };
+        // Clip: that direction has camera z `focus`, so camera z = near is at distance
+        // near * len / focus along the unit direction.
         let length = v.length();
-        let per_z = length / lens.focal_distance;
+        let per_z = length / focus;
         // world_from_camera(t) of the origin: the lens point.
         Ray {
             origin: Point3::from_glam(Vec3::from(cache.eye + offset)),
@@ -238,7 +251,7 @@ impl Camera for PerspectiveCamera {
 
     #[inline]
     fn generate_ray(&self, sample: &CameraSample) -> Option<CameraRay> {
-        let time = ray_time(self.shutter(), sample)?;
+        let time = ray_time(self.base(), sample)?;
         // The call in each arm (not through one merged cache reference) lets LLVM keep the
         // fixed cache's fields where they are.
         let mut ray = match &self.fixed {
@@ -255,7 +268,7 @@ impl Camera for PerspectiveCamera {
 
     #[inline]
     fn generate_ray_differential(&self, sample: &CameraSample) -> Option<CameraRayDifferential> {
-        let time = ray_time(self.shutter(), sample)?;
+        let time = ray_time(self.base(), sample)?;
         // As in generate_ray: the call in each arm keeps the fixed cache read in place.
         Some(match &self.fixed {
             Some(cache) => self.differential(cache, sample, time),

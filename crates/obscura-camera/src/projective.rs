@@ -121,8 +121,8 @@ impl ProjectiveCamera {
     }
     /// The lens (radius 0 for a pinhole).
     #[inline]
-    pub fn lens(&self) -> ThinLens {
-        self.lens
+    pub fn lens(&self) -> &ThinLens {
+        &self.lens
     }
     /// Camera space to screen space: the model's projection.
     #[inline]

@@ -2,9 +2,8 @@
 //! and an aperture stop (Kolb, Mitchell and Hanrahan, "A Realistic Camera Model for Computer
 //! Graphics", SIGGRAPH 1995).
 
-use crate::camera::{
-    Camera, CameraBase, CameraRay, CameraRayDifferential, CameraSample, MAX_BLADES,
-};
+use crate::MAX_BLADES;
+use crate::camera::{Camera, CameraBase, CameraRay, CameraRayDifferential, CameraSample};
 use crate::chain::{self, CameraRayParts, PoseCache};
 use crate::error::{CameraError, finite};
 use glam::{DVec2, DVec3};
@@ -1030,7 +1029,7 @@ impl Camera for RealisticCamera {
     }
 
     fn generate_ray(&self, sample: &CameraSample) -> Option<CameraRay> {
-        let time = crate::camera::ray_time(self.base.shutter, sample)?;
+        let time = crate::camera::ray_time(&self.base, sample)?;
         let (parts, weight) = self.ray_at(sample.p_film, sample.p_lens)?;
         let ray = chain::to_world(&self.pose.world_from_camera(&self.base, time), parts, time);
         Some(CameraRay { ray, weight })

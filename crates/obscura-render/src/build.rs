@@ -11,10 +11,10 @@ use crate::scene::{DEFAULT_INTERAXIAL, camera_key};
 use glam::Vec3;
 use obscura_accel::{Placement, Scene, SceneBuilder, Shape, TriangleMesh};
 use obscura_camera::{
-    AnyCamera, CameraBase, CameraError, CubeFaceCamera, CylindricalCamera, EnvironmentCamera,
-    FilmGeometry, FisheyeCamera, LookAt, OctahedralCamera, OdsCamera, OpenCvCamera,
-    OpenCvFisheyeCamera, OrthographicCamera, PerspectiveCamera, RealisticCamera, RealisticLens,
-    ScreenWindow, look_at_pose, opencv_pose,
+    AnyCamera, ApertureShape, CameraBase, CameraError, CubeFaceCamera, CylindricalCamera,
+    EnvironmentCamera, FilmGeometry, FisheyeCamera, LookAt, OctahedralCamera, OdsCamera,
+    OpenCvCamera, OpenCvFisheyeCamera, OrthographicCamera, PerspectiveCamera, RealisticCamera,
+    RealisticLens, ScreenWindow, look_at_pose, opencv_pose,
 };
 use obscura_sample::Sampler;
 use obscura_shade::{EnvironmentLight, Light, Material, ShadingScene};
@@ -45,6 +45,9 @@ pub struct RenderScene {
     pub pixel_bounds: PixelRect,
     /// Triangles skipped as degenerate while loading meshes, per file.
     pub skipped_triangles: Vec<(PathBuf, usize)>,
+    /// The factor the path integrator's radiance is scaled by when the camera gives exposure
+    /// settings ([`obscura_camera::Exposure::scale`]); None (no scaling at all) otherwise.
+    pub exposure_scale: Option<f32>,
 }
 
 /// The grey diffuse that shapes without a `material` key get.
@@ -181,6 +184,7 @@ impl RenderScene {
         let sampler = Sampler::new(d.sampler.kind, d.sampler.spp, d.sampler.seed)
             .map_err(|e| d.error("sampler", e.to_string()))?;
         let filter = Filter::new(d.film.filter);
+        let exposure_scale = d.camera.exposure.map(|e| e.scale());
         Ok(RenderScene {
             description,
             camera,
@@ -190,6 +194,7 @@ impl RenderScene {
             filter,
             pixel_bounds,
             skipped_triangles,
+            exposure_scale,
         })
     }
 
@@ -310,7 +315,9 @@ pub(crate) fn build_camera(
         window = Some(w);
     }
     let film = FilmGeometry::new(resolution, window, crop)?;
-    let base = CameraBase::new(pose, c.shutter, film).with_clip(c.near, c.far);
+    let base = CameraBase::new(pose, c.shutter, film)
+        .with_clip(c.near, c.far)
+        .with_timing(c.timing.clone());
     // The OpenCV models always have intrinsics from a parsed file; a description built in code
     // without them gets the error a missing fx would.
     let intrinsics = || {
@@ -320,8 +327,10 @@ pub(crate) fn build_camera(
         })
     };
     Ok(match c.kind {
-        CameraKind::Perspective => PerspectiveCamera::new(base, c.fov, c.fov_axis, c.lens)?.into(),
-        CameraKind::Orthographic => OrthographicCamera::new(base, c.lens)?.into(),
+        CameraKind::Perspective => {
+            PerspectiveCamera::new(base, c.fov, c.fov_axis, c.lens.clone())?.into()
+        }
+        CameraKind::Orthographic => OrthographicCamera::new(base, c.lens.clone())?.into(),
         CameraKind::Environment => EnvironmentCamera::new(base)?.into(),
         CameraKind::OpenCv => OpenCvCamera::new(base, intrinsics()?, &c.distortion)?.into(),
         CameraKind::OpenCvFisheye => {
@@ -345,12 +354,21 @@ pub(crate) fn build_camera(
                     line: None,
                     message: "no lens_file".into(),
                 })?;
+            // The stop is round or a polygon: the scene layer refuses aperture images and
+            // squeezes on a lens system.
+            let (blades, rotation_degrees) = match c.lens.aperture.shape {
+                ApertureShape::Polygon {
+                    blades,
+                    rotation_degrees,
+                } => (blades, rotation_degrees),
+                _ => (0, 0.0),
+            };
             let lens = RealisticLens {
                 aperture_diameter: r.aperture_diameter,
                 focus_distance: r.focus_distance,
                 film_diagonal: r.film_diagonal,
-                blades: c.lens.blades,
-                rotation_degrees: c.lens.rotation_degrees,
+                blades,
+                rotation_degrees,
             };
             RealisticCamera::new(base, &r.prescription, lens)?.into()
         }

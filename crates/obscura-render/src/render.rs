@@ -313,7 +313,12 @@ pub fn sample_value(
 ) -> (Vec3, bool) {
     let kind = scene.integrator();
     if kind == IntegratorKind::Path {
-        return path.li_and_hit(&scene.geometry, &scene.shading, ray, stream);
+        let (radiance, hit) = path.li_and_hit(&scene.geometry, &scene.shading, ray, stream);
+        // Photographic exposure scales radiance only, never the AOVs below.
+        return match scene.exposure_scale {
+            Some(scale) => (radiance * scale, hit),
+            None => (radiance, hit),
+        };
     }
     let Some(hit) = scene.geometry.intersect(ray) else {
         return (Vec3::ZERO, false);

@@ -45,4 +45,10 @@ pub enum SampleError {
         /// The rotation that was given.
         degrees: f32,
     },
+    /// A piecewise-linear shutter curve that is not a valid density over the interval.
+    #[error("shutter_curve: {reason}")]
+    InvalidShutterCurve {
+        /// What is wrong with it, naming the offending point.
+        reason: String,
+    },
 }

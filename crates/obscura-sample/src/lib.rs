@@ -7,7 +7,8 @@
 //! cursor over the dimensions of one sample whose first call, [`SampleStream::camera`], gives
 //! the camera's film offset, lens sample and time as plain glam values. Warps turn canonical numbers into shapes:
 //! [`square_to_concentric_disk`] and [`square_to_polygon`] for the aperture,
-//! [`ShutterCurve`] and [`shutter_time`] for the shutter, [`square_to_cosine_hemisphere`] and
+//! [`ShutterCurve`], [`PiecewiseShutterCurve`] and [`shutter_time`] for the shutter,
+//! [`Distribution2D`] for apertures and environment maps drawn in proportion to an image, [`square_to_cosine_hemisphere`] and
 //! [`square_to_uniform_sphere`] for shading, each with its pdf. [`sin_cos_pi`] (and [`sin_cos_pi_vec4`]) is the short
 //! sine and cosine the per-sample warps and cameras use instead of libm's. Errors are
 //! [`SampleError`].
@@ -46,6 +47,7 @@
 
 #![deny(missing_docs)]
 
+mod distribution;
 mod error;
 mod hash;
 mod sampler;
@@ -54,10 +56,11 @@ mod shutter;
 mod trig;
 mod warp;
 
+pub use distribution::{Distribution1D, Distribution2D};
 pub use error::SampleError;
 pub use hash::ONE_MINUS_EPSILON;
 pub use sampler::{MAX_SAMPLES_PER_PIXEL, SampleStream, Sampler, SamplerKind};
-pub use shutter::{ShutterCurve, shutter_time};
+pub use shutter::{PiecewiseShutterCurve, ShutterCurve, shutter_time};
 pub use trig::{sin_cos_pi, sin_cos_pi_vec4};
 pub use warp::{
     concentric_disk_pdf, concentric_disk_to_square, cosine_hemisphere_pdf,

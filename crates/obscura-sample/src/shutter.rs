@@ -111,6 +111,150 @@ impl ShutterCurve {
     }
 }
 
+/// A shutter's openness over the normalised interval `[0, 1]` as a piecewise-linear curve
+/// through `(t, openness)` points (the scene format's `shutter_curve`), zero before the first
+/// point and after the last.
+///
+/// Times are drawn by inverting the curve's integral: with `O(t)` the openness and
+/// `A = integral of O over [0, 1]`, [`PiecewiseShutterCurve::sample`] returns the `t` with
+/// `integral of O over [0, t] = u A`. On a segment from `(t0, o0)` to `(t1, o1)` with slope
+/// `a = (o1 - o0) / (t1 - t0)` the area `r` past `t0` is reached at
+/// `s = 2 r / (o0 + sqrt(o0^2 + 2 a r))` (the stable root of `a s^2 / 2 + o0 s = r`). The map
+/// is monotonic, so equal-weight strata of `u` stay equal-weight strata of exposure.
+/// [`ShutterCurve::Trapezoid`] is the closed-form special case `[[0, 0], [r, 1], [1 - r, 1], [1, 0]]`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PiecewiseShutterCurve {
+    /// The points, `t` strictly increasing in `[0, 1]`.
+    points: Vec<[f64; 2]>,
+    /// `cumulative[i]`: the area under the curve from `t = points[0].t` to `points[i].t`.
+    cumulative: Vec<f64>,
+}
+
+impl PiecewiseShutterCurve {
+    /// The curve through `points` (`[t, openness]`). Errors unless there are at least two
+    /// points, every number is finite, `t` is strictly increasing within `[0, 1]`, openness
+    /// is `>= 0`, and the area under the curve is positive.
+    pub fn new(points: &[[f32; 2]]) -> Result<PiecewiseShutterCurve, SampleError> {
+        let bad = |reason: String| Err(SampleError::InvalidShutterCurve { reason });
+        if points.len() < 2 {
+            return bad(format!(
+                "needs at least two [t, openness] points, got {}",
+                points.len()
+            ));
+        }
+        for (i, &[t, o]) in points.iter().enumerate() {
+            if !(t.is_finite() && o.is_finite()) {
+                return bad(format!("point {i} [{t}, {o}] is not finite"));
+            }
+            if !(0.0..=1.0).contains(&t) {
+                return bad(format!(
+                    "point {i} has t = {t}; times are fractions of the shutter interval in [0, 1]"
+                ));
+            }
+            if o < 0.0 {
+                return bad(format!("point {i} has negative openness {o}"));
+            }
+            if i > 0 && t <= points[i - 1][0] {
+                return bad(format!(
+                    "t must increase from point to point, but point {i} has t = {t} after {}",
+                    points[i - 1][0]
+                ));
+            }
+        }
+        let points: Vec<[f64; 2]> = points
+            .iter()
+            .map(|&[t, o]| [f64::from(t), f64::from(o)])
+            .collect();
+        let mut cumulative = Vec::with_capacity(points.len());
+        let mut area = 0.0;
+        cumulative.push(0.0);
+        for pair in points.windows(2) {
+            area += 0.5 * (pair[0][1] + pair[1][1]) * (pair[1][0] - pair[0][0]);
+            cumulative.push(area);
+        }
+        if area <= 0.0 {
+            return bad("the shutter is never open (the area under the curve is 0)".to_string());
+        }
+        Ok(PiecewiseShutterCurve { points, cumulative })
+    }
+
+    /// The points as given.
+    pub fn points(&self) -> Vec<[f32; 2]> {
+        self.points
+            .iter()
+            .map(|p| [p[0] as f32, p[1] as f32])
+            .collect()
+    }
+
+    /// The area under the curve over `[0, 1]`.
+    fn area(&self) -> f64 {
+        self.cumulative[self.cumulative.len() - 1]
+    }
+
+    /// The openness at normalised time `t` (linear between points, 0 outside them).
+    pub fn openness(&self, t: f32) -> f32 {
+        let t = f64::from(t);
+        let first = self.points[0][0];
+        let last = self.points[self.points.len() - 1][0];
+        if !(first..=last).contains(&t) {
+            return 0.0;
+        }
+        let i = self
+            .points
+            .partition_point(|p| p[0] <= t)
+            .clamp(1, self.points.len() - 1);
+        let ([t0, o0], [t1, o1]) = (self.points[i - 1], self.points[i]);
+        (o0 + (o1 - o0) * (t - t0) / (t1 - t0)) as f32
+    }
+
+    /// The density of [`PiecewiseShutterCurve::sample`] at `t`: openness over the area.
+    pub fn pdf(&self, t: f32) -> f32 {
+        (f64::from(self.openness(t)) / self.area()) as f32
+    }
+
+    /// Warps a canonical `u` in `[0, 1)` to a normalised time with density
+    /// [`PiecewiseShutterCurve::pdf`].
+    pub fn sample(&self, u: f32) -> f32 {
+        let target = f64::from(u.clamp(0.0, ONE_MINUS_EPSILON)) * self.area();
+        // The segment whose area span holds the target, skipping closed (zero-area) ones.
+        let n = self.points.len();
+        let mut i = self
+            .cumulative
+            .partition_point(|&c| c <= target)
+            .clamp(1, n - 1);
+        while i + 1 < n && self.cumulative[i] <= self.cumulative[i - 1] {
+            i += 1;
+        }
+        let ([t0, o0], [t1, o1]) = (self.points[i - 1], self.points[i]);
+        let r = (target - self.cumulative[i - 1]).max(0.0);
+        let slope = (o1 - o0) / (t1 - t0);
+        let root = (o0 * o0 + 2.0 * slope * r).max(0.0).sqrt();
+        let s = if o0 + root > 0.0 {
+            2.0 * r / (o0 + root)
+        } else {
+            0.0
+        };
+        ((t0 + s.min(t1 - t0)) as f32).clamp(0.0, ONE_MINUS_EPSILON)
+    }
+
+    /// The distribution function: the `u` that [`PiecewiseShutterCurve::sample`] maps to `t`.
+    pub fn invert(&self, t: f32) -> f32 {
+        let t = f64::from(t);
+        let n = self.points.len();
+        if t <= self.points[0][0] {
+            return 0.0;
+        }
+        if t >= self.points[n - 1][0] {
+            return ONE_MINUS_EPSILON;
+        }
+        let i = self.points.partition_point(|p| p[0] <= t).clamp(1, n - 1);
+        let ([t0, o0], [t1, o1]) = (self.points[i - 1], self.points[i]);
+        let s = t - t0;
+        let area = o0 * s + 0.5 * (o1 - o0) / (t1 - t0) * s * s;
+        (((self.cumulative[i - 1] + area) / self.area()) as f32).clamp(0.0, ONE_MINUS_EPSILON)
+    }
+}
+
 /// Maps a normalised time `u` in `[0, 1)` into the shutter interval `[open, close]` of the
 /// scene format: `open + u * (close - open)`.
 #[inline]
@@ -151,5 +295,62 @@ mod tests {
     fn shutter_time_hand_case() {
         // open 2, close 4, u = 0.25 -> 2 + 0.25 * 2 = 2.5.
         assert_eq!(shutter_time(0.25, [2.0, 4.0]), 2.5);
+    }
+    #[test]
+    fn piecewise_hand_cases() {
+        // A ramp from 0 to 1 over [0, 1]: O(t) = t, area 1/2, CDF t^2, so u = 1/4 -> t = 1/2.
+        let ramp = PiecewiseShutterCurve::new(&[[0.0, 0.0], [1.0, 1.0]]).unwrap();
+        assert!((ramp.sample(0.25) - 0.5).abs() < 1e-6);
+        assert!((ramp.invert(0.5) - 0.25).abs() < 1e-6);
+        assert!((ramp.pdf(0.5) - 1.0).abs() < 1e-6);
+        // A box over [0.5, 1] with openness 2: uniform there, nothing before.
+        let late = PiecewiseShutterCurve::new(&[[0.5, 2.0], [1.0, 2.0]]).unwrap();
+        assert!((late.sample(0.5) - 0.75).abs() < 1e-6);
+        assert_eq!(late.pdf(0.25), 0.0);
+        assert!((late.pdf(0.75) - 2.0).abs() < 1e-6);
+        // The trapezoid as points gives the closed form's times.
+        let trapezoid = ShutterCurve::trapezoid(0.25).unwrap();
+        let points =
+            PiecewiseShutterCurve::new(&[[0.0, 0.0], [0.25, 1.0], [0.75, 1.0], [1.0, 0.0]])
+                .unwrap();
+        for k in 0..20 {
+            let u = k as f32 / 20.0;
+            assert!((points.sample(u) - trapezoid.sample(u)).abs() < 1e-5, "{u}");
+        }
+    }
+
+    #[test]
+    fn piecewise_rejects_bad_curves() {
+        for bad in [
+            &[[0.0, 1.0]][..],
+            &[[0.0, 1.0], [0.0, 1.0]],
+            &[[0.5, 1.0], [0.25, 1.0]],
+            &[[0.0, -1.0], [1.0, 1.0]],
+            &[[0.0, f32::NAN], [1.0, 1.0]],
+            &[[0.0, 1.0], [1.5, 1.0]],
+            &[[0.0, 0.0], [1.0, 0.0]],
+        ] {
+            assert!(PiecewiseShutterCurve::new(bad).is_err(), "{bad:?}");
+        }
+    }
+
+    proptest::proptest! {
+        #[test]
+        fn piecewise_sample_inverts(
+            opens in proptest::collection::vec(0.0f32..4.0, 2..6),
+            u in 0.0f32..1.0,
+        ) {
+            let n = opens.len();
+            let points: Vec<[f32; 2]> = opens
+                .iter()
+                .enumerate()
+                .map(|(i, &o)| [i as f32 / (n - 1) as f32, o])
+                .collect();
+            if let Ok(curve) = PiecewiseShutterCurve::new(&points) {
+                let t = curve.sample(u);
+                proptest::prop_assert!((0.0..1.0).contains(&t));
+                proptest::prop_assert!((curve.invert(t) - u).abs() < 2e-4, "{} {}", t, u);
+            }
+        }
     }
 }

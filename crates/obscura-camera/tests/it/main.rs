@@ -16,6 +16,7 @@ mod motion;
 mod octahedral;
 mod ods;
 mod opencv;
+mod photo;
 mod projective;
 mod ray_checks;
 mod sample_use;
@@ -171,7 +172,7 @@ pub fn environment_strategy() -> impl Strategy<Value = EnvironmentCamera> {
 /// and the environment camera (which has none).
 pub fn models(base: CameraBase, lens: ThinLens) -> [AnyCamera; 3] {
     [
-        PerspectiveCamera::new(base.clone(), 60.0, FovAxis::Smaller, lens)
+        PerspectiveCamera::new(base.clone(), 60.0, FovAxis::Smaller, lens.clone())
             .unwrap()
             .into(),
         OrthographicCamera::new(base.clone(), lens).unwrap().into(),

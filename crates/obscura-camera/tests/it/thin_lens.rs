@@ -27,8 +27,8 @@ fn with_lens(camera: &AnyCamera, lens: ThinLens) -> AnyCamera {
 
 fn lens_of(camera: &AnyCamera) -> ThinLens {
     match camera {
-        AnyCamera::Perspective(c) => c.lens(),
-        AnyCamera::Orthographic(c) => c.lens(),
+        AnyCamera::Perspective(c) => c.lens().clone(),
+        AnyCamera::Orthographic(c) => c.lens().clone(),
         _ => unreachable!(),
     }
 }
@@ -46,7 +46,7 @@ proptest! {
         blades in prop_oneof![Just(0u32), 3u32..9],
     ) {
         let lens = lens_of(&camera).with_blades(blades, 10.0).unwrap();
-        let camera = with_lens(&camera, lens);
+        let camera = with_lens(&camera, lens.clone());
         let p_film = raster_in(camera.film().resolution(), fx, fy);
         let camera_from_world = camera.world_from_camera().at(0.0).inverse();
         let pinhole = with_lens(&camera, ThinLens::PINHOLE);

@@ -26,33 +26,35 @@ fn perspective(
 fn perspective_rejects_bad_parameters() {
     let ok = ThinLens::PINHOLE;
     for fov in [0.0, 180.0, -10.0, 200.0] {
-        let e = perspective(fov, 0.1, 10.0, ok).unwrap_err();
+        let e = perspective(fov, 0.1, 10.0, ok.clone()).unwrap_err();
         assert_eq!(e, CameraError::Fov { got: fov });
     }
     assert_eq!(
-        perspective(180.0, 0.1, 10.0, ok).unwrap_err().to_string(),
+        perspective(180.0, 0.1, 10.0, ok.clone())
+            .unwrap_err()
+            .to_string(),
         "fov must be in (0, 180) degrees, got 180"
     );
     assert!(
-        perspective(f32::NAN, 0.1, 10.0, ok)
+        perspective(f32::NAN, 0.1, 10.0, ok.clone())
             .unwrap_err()
             .to_string()
             .starts_with("fov ")
     );
     assert!(matches!(
-        perspective(45.0, 0.0, 10.0, ok),
+        perspective(45.0, 0.0, 10.0, ok.clone()),
         Err(CameraError::Near { positive: true, .. })
     ));
     assert!(matches!(
-        perspective(45.0, 10.0, 10.0, ok),
+        perspective(45.0, 10.0, 10.0, ok.clone()),
         Err(CameraError::NearFar { .. })
     ));
     assert!(matches!(
-        perspective(45.0, 0.1, f32::INFINITY, ok),
+        perspective(45.0, 0.1, f32::INFINITY, ok.clone()),
         Err(CameraError::NonFinite { what: "far", .. })
     ));
     assert!(matches!(
-        perspective(45.0, f32::NAN, 1.0, ok),
+        perspective(45.0, f32::NAN, 1.0, ok.clone()),
         Err(CameraError::NonFinite { what: "near", .. })
     ));
     let bad_lens = ThinLens {
@@ -77,7 +79,13 @@ fn perspective_rejects_bad_parameters() {
             .contains("focal_distance")
     );
     let bad_blades = ThinLens {
-        blades: 2,
+        aperture: obscura_camera::Aperture {
+            shape: obscura_camera::ApertureShape::Polygon {
+                blades: 2,
+                rotation_degrees: 0.0,
+            },
+            anamorphic: 1.0,
+        },
         ..ThinLens::PINHOLE
     };
     assert!(matches!(

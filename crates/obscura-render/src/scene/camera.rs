@@ -11,12 +11,15 @@ use super::settings::{
 };
 use crate::error::RenderError;
 use obscura_camera::{
-    CameraError, CubeFace, DEFAULT_FILM_DIAGONAL, FisheyeProjection, FovAxis, LensPrescription,
-    LookAt, OpenCvIntrinsics, ScreenWindow, Shutter, StereoRig, ThinLens, opencv_pose,
+    Aperture, ApertureImage, CameraError, CubeFace, DEFAULT_FILM_DIAGONAL, Exposure,
+    FisheyeProjection, FovAxis, LensPrescription, LookAt, OpenCvIntrinsics, RollingDirection,
+    RollingShutter, ScreenWindow, Shutter, ShutterTiming, StereoRig, ThinLens, opencv_pose,
     validate_clip, validate_fov,
 };
+use obscura_sample::PiecewiseShutterCurve;
 use obscura_space::{Camera as CameraSpace, Point3, SpaceError, Transform, Vector3, World};
 use std::path::Path;
+use std::sync::Arc;
 
 /// The realistic camera's focus distance when the scene gives none (world units, metres):
 /// 10, as pbrt-v4's.
@@ -35,7 +38,8 @@ pub(crate) fn camera_key(e: &CameraError) -> &'static str {
             "fov" => "camera.fov",
             "lens_radius" => "camera.lens_radius",
             "focal_distance" => "camera.focal_distance",
-            "aperture rotation" => "camera.aperture_rotation",
+            "aperture rotation" | "aperture_rotation" => "camera.aperture_rotation",
+            "anamorphic" => "camera.anamorphic",
             "lens_shift" => "camera.lens_shift",
             "fx" => "camera.fx",
             "fy" => "camera.fy",
@@ -78,6 +82,22 @@ pub(crate) fn camera_key(e: &CameraError) -> &'static str {
         CameraError::ApertureDiameter { .. } => "camera.aperture_diameter",
         CameraError::FocusDistance { .. } => "camera.focus_distance",
         CameraError::FilmDiagonal { .. } => "camera.film_diagonal",
+        CameraError::ApertureImage { .. } => "camera.aperture_image",
+        CameraError::Anamorphic { .. } => "camera.anamorphic",
+        CameraError::ShutterCurve(_) => "camera.shutter_curve",
+        CameraError::RollingReadout { .. } | CameraError::UnknownRollingDirection(_) => {
+            "camera.rolling_shutter"
+        }
+        CameraError::FocalPlaneTilt { .. } | CameraError::TiltWithoutLens => {
+            "camera.focal_plane_tilt"
+        }
+        CameraError::Exposure { what, .. } => match *what {
+            "f_number" => "camera.f_number",
+            "shutter_time" => "camera.shutter_time",
+            "iso" => "camera.iso",
+            _ => "camera.exposure_compensation",
+        },
+        CameraError::LensRadiusDisagrees { .. } => "camera.lens_radius",
     }
 }
 
@@ -88,13 +108,13 @@ fn reads(kind: CameraKind, key: &str) -> bool {
     match key {
         "fov" => matches!(kind, Perspective | Fisheye | Cylindrical),
         "fov_axis" => kind == Perspective,
-        "screen_window" | "lens_radius" | "focal_distance" => {
-            matches!(kind, Perspective | Orthographic)
-        }
+        "screen_window" | "lens_radius" | "focal_distance" | "aperture_image" | "anamorphic"
+        | "focal_length" => matches!(kind, Perspective | Orthographic),
         "aperture_blades" | "aperture_rotation" => {
             matches!(kind, Perspective | Orthographic | Realistic)
         }
         "lens_file" | "aperture_diameter" | "focus_distance" | "film_diagonal" => kind == Realistic,
+        "focal_plane_tilt" => kind == Perspective,
         "lens_shift" => matches!(kind, Perspective | Orthographic | Fisheye),
         "fx" | "fy" | "cx" | "cy" | "distortion" => matches!(kind, OpenCv | OpenCvFisheye),
         "projection" => kind == Fisheye,
@@ -148,6 +168,10 @@ impl Cx<'_> {
             ("aperture_diameter", c.aperture_diameter.is_some()),
             ("focus_distance", c.focus_distance.is_some()),
             ("film_diagonal", c.film_diagonal.is_some()),
+            ("aperture_image", c.aperture_image.is_some()),
+            ("anamorphic", c.anamorphic.is_some()),
+            ("focal_plane_tilt", c.focal_plane_tilt.is_some()),
+            ("focal_length", c.focal_length.is_some()),
         ];
         for (key, _) in given.iter().filter(|(k, g)| *g && !reads(kind, k)) {
             ignored.push(format!("camera.{key} is ignored by the {name} camera"));
@@ -248,7 +272,7 @@ impl Cx<'_> {
         if perspective {
             validate_fov(fov).map_err(|e| self.camera_err(e))?;
         }
-        let fov_axis = match c.fov_axis {
+        let fov_axis = match c.fov_axis.as_deref() {
             Some(name) => name.parse::<FovAxis>().map_err(|e| self.camera_err(e))?,
             None => FovAxis::Smaller,
         };
@@ -261,19 +285,57 @@ impl Cx<'_> {
         let near = c.near.unwrap_or(if perspective { 0.001 } else { 0.0 });
         let far = c.far.unwrap_or(1.0e30);
         validate_clip(near, far, perspective).map_err(|e| self.camera_err(e))?;
-        let lens = ThinLens::new(
-            c.lens_radius.unwrap_or(0.0),
-            c.focal_distance.unwrap_or(1.0),
-        )
-        .and_then(|lens| {
-            lens.with_blades(
-                c.aperture_blades.unwrap_or(0),
-                c.aperture_rotation.unwrap_or(0.0),
-            )
-        })
-        .map_err(|e| self.camera_err(e))?;
         let shutter = c.shutter.unwrap_or([0.0, 1.0]);
         let shutter = Shutter::new(shutter[0], shutter[1]).map_err(|e| self.camera_err(e))?;
+        let exposure = self.exposure(&c)?;
+        let lens_radius = self.lens_radius(&c, exposure.as_ref())?;
+        let lens = ThinLens::new(lens_radius, c.focal_distance.unwrap_or(1.0))
+            .and_then(|lens| {
+                lens.with_blades(
+                    c.aperture_blades.unwrap_or(0),
+                    c.aperture_rotation.unwrap_or(0.0),
+                )
+            })
+            .map_err(|e| self.camera_err(e))?;
+        let lens = match &c.aperture_image {
+            Some(file) => {
+                if c.aperture_blades.is_some() {
+                    return Err(self.err(
+                        "camera.aperture_image",
+                        "give the aperture either as blades (aperture_blades) or as an image \
+                         (aperture_image), not both",
+                    ));
+                }
+                let image = self.aperture_image(file)?;
+                lens.with_aperture(Aperture::image(image))
+                    .map_err(|e| self.camera_err(e))?
+            }
+            None => lens,
+        };
+        let lens = match c.anamorphic {
+            Some(squeeze) => {
+                let aperture = lens
+                    .aperture
+                    .clone()
+                    .with_anamorphic(squeeze)
+                    .map_err(|e| self.camera_err(e))?;
+                lens.with_aperture(aperture)
+                    .map_err(|e| self.camera_err(e))?
+            }
+            None => lens,
+        };
+        let lens = match c.focal_plane_tilt {
+            Some(tilt) => {
+                self.finite("camera.focal_plane_tilt", &tilt)?;
+                if kind == CameraKind::Perspective {
+                    lens.with_tilt(tilt).map_err(|e| self.camera_err(e))?
+                } else {
+                    lens
+                }
+            }
+            None => lens,
+        };
+        let timing = self.timing(&c, shutter)?;
         if extrinsics.is_some() && end.is_some() {
             return Err(self.err(
                 "camera.rvec",
@@ -391,6 +453,8 @@ impl Cx<'_> {
             far,
             lens,
             shutter,
+            timing,
+            exposure,
             extrinsics,
             intrinsics,
             distortion,
@@ -445,6 +509,120 @@ impl Cx<'_> {
         })
     }
 
+    /// `f_number`, `shutter_time`, `iso`, `exposure_compensation`: None when none is given
+    /// (the image is then unchanged), else the settings with the others at their defaults.
+    fn exposure(&self, c: &RawCamera) -> Result<Option<Exposure>, RenderError> {
+        if c.f_number.is_none()
+            && c.shutter_time.is_none()
+            && c.iso.is_none()
+            && c.exposure_compensation.is_none()
+        {
+            return Ok(None);
+        }
+        let exposure = Exposure {
+            f_number: c.f_number.unwrap_or(Exposure::UNIT.f_number),
+            shutter_time: c.shutter_time.unwrap_or(Exposure::UNIT.shutter_time),
+            iso: c.iso.unwrap_or(Exposure::UNIT.iso),
+            compensation: c.exposure_compensation.unwrap_or(0.0),
+        };
+        exposure.validate().map_err(|e| self.camera_err(e))?;
+        Ok(Some(exposure))
+    }
+
+    /// `lens_radius`, or `focal_length / (2 f_number)` when `focal_length` is given (which
+    /// needs `f_number`); both given and disagreeing is an error.
+    fn lens_radius(&self, c: &RawCamera, exposure: Option<&Exposure>) -> Result<f32, RenderError> {
+        let Some(focal_length) = c.focal_length else {
+            return Ok(c.lens_radius.unwrap_or(0.0));
+        };
+        if !(focal_length.is_finite() && focal_length > 0.0) {
+            return Err(self.err(
+                "camera.focal_length",
+                format!("focal_length must be a finite number > 0, got {focal_length}"),
+            ));
+        }
+        let Some(exposure) = exposure.filter(|_| c.f_number.is_some()) else {
+            return Err(self.err(
+                "camera.focal_length",
+                "focal_length gives lens_radius = focal_length / (2 f_number): f_number is \
+                 missing",
+            ));
+        };
+        let derived = exposure.lens_radius(focal_length);
+        // NaN never agrees.
+        let agrees = |given: f32| (given - derived).abs() <= 1e-4 * derived;
+        if let Some(given) = c.lens_radius
+            && !agrees(given)
+        {
+            return Err(self.camera_err(CameraError::LensRadiusDisagrees {
+                lens_radius: given,
+                derived,
+            }));
+        }
+        Ok(derived)
+    }
+
+    /// The aperture image: a PNG (or any format the image crate reads) relative to the scene
+    /// file, decoded to linear luminance weights (sRGB decoded, Rec. 709 luminance, times
+    /// alpha).
+    fn aperture_image(&self, file: &str) -> Result<ApertureImage, RenderError> {
+        let path = self.file.parent().unwrap_or(Path::new("")).join(file);
+        let decoded = image::open(&path).map_err(|e| {
+            self.err(
+                "camera.aperture_image",
+                format!("cannot read the aperture image {}: {e}", path.display()),
+            )
+        })?;
+        let rgba = decoded.to_rgba8();
+        let (width, height) = rgba.dimensions();
+        let weights: Vec<f32> = rgba
+            .pixels()
+            .map(|p| {
+                let [r, g, b] = [p[0], p[1], p[2]].map(srgb_to_linear);
+                (0.2126 * r + 0.7152 * g + 0.0722 * b) * f32::from(p[3]) / 255.0
+            })
+            .collect();
+        ApertureImage::new(&weights, width as usize, height as usize).map_err(|e| {
+            self.err(
+                "camera.aperture_image",
+                format!("{} ({})", e, path.display()),
+            )
+        })
+    }
+
+    /// `shutter_curve` and `rolling_shutter`.
+    fn timing(&self, c: &RawCamera, shutter: Shutter) -> Result<ShutterTiming, RenderError> {
+        let curve = match &c.shutter_curve {
+            Some(points) => Some(Arc::new(
+                PiecewiseShutterCurve::new(points)
+                    .map_err(|e| self.camera_err(CameraError::ShutterCurve(e.to_string())))?,
+            )),
+            None => None,
+        };
+        let rolling = match &c.rolling_shutter {
+            Some(r) => {
+                let Some(readout) = r.readout else {
+                    return Err(self.err(
+                        "camera.rolling_shutter",
+                        "rolling_shutter needs `readout`, the seconds from the first row's \
+                         opening to the last's",
+                    ));
+                };
+                let direction = match &r.direction {
+                    Some(d) => d
+                        .parse::<RollingDirection>()
+                        .map_err(|e| self.camera_err(e))?,
+                    None => RollingDirection::TopToBottom,
+                };
+                Some(RollingShutter { readout, direction })
+            }
+            None => None,
+        };
+        let timing = ShutterTiming { curve, rolling };
+        timing.validate(shutter).map_err(|e| self.camera_err(e))?;
+        Ok(timing)
+    }
+
     /// Checks a look-at frame by building its pose; a degenerate one is reported at the key
     /// that makes it so (`target` for eye == target, `up` for a bad up vector).
     fn look_at(&self, end: bool, l: &LookAt) -> Result<(), RenderError> {
@@ -461,6 +639,16 @@ impl Cx<'_> {
             }
             Err(e) => Err(self.err(if end { "camera.eye_end" } else { "camera" }, e.to_string())),
         }
+    }
+}
+
+/// The sRGB transfer function's inverse: an 8-bit code to linear.
+fn srgb_to_linear(code: u8) -> f32 {
+    let v = f32::from(code) / 255.0;
+    if v <= 0.04045 {
+        v / 12.92
+    } else {
+        ((v + 0.055) / 1.055).powf(2.4)
     }
 }
 
@@ -559,6 +747,24 @@ mod tests {
             ("aperture_blades = 2", "camera.aperture_blades"),
             ("aperture_blades = 65", "camera.aperture_blades"),
             ("shutter = [1.0, 0.0]", "camera.shutter"),
+            ("anamorphic = 0.5", "camera.anamorphic"),
+            (
+                "shutter_curve = [[0.5, 1.0], [0.2, 1.0]]",
+                "camera.shutter_curve",
+            ),
+            (
+                "rolling_shutter = { readout = 2.0 }",
+                "camera.rolling_shutter",
+            ),
+            ("focal_plane_tilt = [5.0, 0.0]", "camera.focal_plane_tilt"),
+            ("f_number = -2.0", "camera.f_number"),
+            ("iso = 0.0", "camera.iso"),
+            ("shutter_time = 0.0", "camera.shutter_time"),
+            (
+                "exposure_compensation = 500.0",
+                "camera.exposure_compensation",
+            ),
+            ("focal_length = 0.05", "camera.focal_length"),
             (
                 "screen_window = [1.0, -1.0, -1.0, 1.0]",
                 "camera.screen_window",

@@ -88,7 +88,7 @@ pub fn parse_description(path: &Path, source: &str) -> Result<SceneDescription, 
 
 /// The file and its text, for errors that find their own line.
 pub(super) struct Cx<'a> {
-    file: &'a Path,
+    pub(super) file: &'a Path,
     source: &'a str,
 }
 

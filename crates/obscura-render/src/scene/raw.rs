@@ -85,6 +85,23 @@ pub(super) struct RawCamera {
     pub(super) aperture_diameter: Option<f32>,
     pub(super) focus_distance: Option<f32>,
     pub(super) film_diagonal: Option<f32>,
+    pub(super) aperture_image: Option<String>,
+    pub(super) anamorphic: Option<f32>,
+    pub(super) shutter_curve: Option<Vec<[f32; 2]>>,
+    pub(super) rolling_shutter: Option<RawRollingShutter>,
+    pub(super) focal_plane_tilt: Option<[f32; 2]>,
+    pub(super) f_number: Option<f32>,
+    pub(super) shutter_time: Option<f32>,
+    pub(super) iso: Option<f32>,
+    pub(super) exposure_compensation: Option<f32>,
+    pub(super) focal_length: Option<f32>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawRollingShutter {
+    pub(super) readout: Option<f32>,
+    pub(super) direction: Option<String>,
 }
 
 #[derive(Deserialize)]

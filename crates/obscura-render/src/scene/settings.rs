@@ -3,8 +3,8 @@
 use crate::error::RenderError;
 use obscura_accel::TriangleMesh;
 use obscura_camera::{
-    CubeFace, FisheyeProjection, FovAxis, LensPrescription, LookAt, OpenCvIntrinsics, ScreenWindow,
-    Shutter, StereoEye, StereoRig, ThinLens,
+    CubeFace, Exposure, FisheyeProjection, FovAxis, LensPrescription, LookAt, OpenCvIntrinsics,
+    ScreenWindow, Shutter, ShutterTiming, StereoEye, StereoRig, ThinLens,
 };
 use obscura_sample::SamplerKind;
 use obscura_space::{Camera as CameraSpace, Object, Transform, World};
@@ -310,10 +310,16 @@ pub struct CameraSettings {
     pub near: f32,
     /// Far clip.
     pub far: f32,
-    /// The lens: radius (0 for a pinhole), focal distance, aperture blades and rotation.
+    /// The lens: radius (0 for a pinhole), focal distance, aperture (blades and rotation, an
+    /// image, the anamorphic squeeze) and the focal plane's tilt.
     pub lens: ThinLens,
     /// Shutter open and close times.
     pub shutter: Shutter,
+    /// How ray times spread over the shutter: `shutter_curve` and `rolling_shutter`.
+    pub timing: ShutterTiming,
+    /// `f_number`, `shutter_time`, `iso`, `exposure_compensation`, when any is given: the
+    /// path integrator's radiance is then scaled by [`Exposure::scale`].
+    pub exposure: Option<Exposure>,
     /// OpenCV extrinsics `rvec`, `tvec`: when given, the pose instead of the look-at.
     pub extrinsics: Option<Extrinsics>,
     /// `fx`, `fy`, `cx`, `cy` of the OpenCV models.

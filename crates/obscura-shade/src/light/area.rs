@@ -4,11 +4,11 @@ use super::solid_angle::{
     area_to_solid_angle, cone_pdf, normal_matrix, orientation_sign, world_sphere,
 };
 use super::{LightSample, TINY};
-use crate::distribution::Distribution1D;
 use crate::error::{ShadeError, check_non_negative};
 use core::f32::consts::{PI, TAU};
 use glam::{Mat3, Vec2, Vec3};
 use obscura_accel::{Placement, Shape, TriangleMesh};
+use obscura_sample::Distribution1D;
 use obscura_sample::square_to_uniform_sphere;
 use obscura_space::{Object, Transform, World};
 

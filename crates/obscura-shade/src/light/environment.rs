@@ -2,10 +2,10 @@
 //! luminance.
 
 use super::{LightSample, TINY, luminance};
-use crate::distribution::Distribution2D;
 use crate::error::{ShadeError, check_non_negative};
 use core::f32::consts::{PI, TAU};
 use glam::{Mat3, Mat4, Vec2, Vec3};
+use obscura_sample::Distribution2D;
 use obscura_sample::{square_to_uniform_sphere, uniform_sphere_pdf};
 
 /// Light from every direction at infinity: a constant radiance or an equirectangular map.

@@ -1,8 +1,8 @@
 //! Piecewise-constant distributions in one and two dimensions, for importance sampling
 //! environment maps and choosing triangles by area.
 
+use crate::hash::ONE_MINUS_EPSILON;
 use glam::Vec2;
-use obscura_sample::ONE_MINUS_EPSILON;
 
 /// A piecewise-constant density over `[0, 1)` with `n` equal bins of non-negative weights.
 /// When every weight is zero it falls back to the uniform density (so sampling never fails).
