@@ -6,6 +6,7 @@ mod gallery;
 mod opencv;
 mod robust;
 mod scenes;
+mod slices;
 mod views;
 
 use obscura_render::{

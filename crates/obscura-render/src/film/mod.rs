@@ -43,9 +43,10 @@ fn from_fixed(v: i128) -> f64 {
 /// Integers, so that additions are exact and associative: a film is the same bits whatever
 /// order its tiles and passes are added in, which is what lets a render be split into slices
 /// (of passes or tiles) on several machines and merged to the one-machine image bit for bit,
-/// and a checkpoint be resumed exactly. Additions wrap (two's complement), which keeps them
-/// associative even past the range; a pixel whose true sum leaves `+-2^63` is wrong either
-/// way.
+/// and a checkpoint be resumed exactly. The range is `+-2^63` (about 9.2e18) per sum; past it
+/// additions saturate, so an absurdly bright pixel stays finite and bright. Saturating sums of
+/// one sign are still associative; only sums that mix signs (negative filter lobes) and pass
+/// the range may then depend on the order.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct PixelSums {
     /// Sum of weight times radiance.
@@ -59,10 +60,10 @@ pub struct PixelSums {
 impl PixelSums {
     fn add(&mut self, o: &PixelSums) {
         for c in 0..3 {
-            self.radiance[c] = self.radiance[c].wrapping_add(o.radiance[c]);
+            self.radiance[c] = self.radiance[c].saturating_add(o.radiance[c]);
         }
-        self.weight = self.weight.wrapping_add(o.weight);
-        self.coverage = self.coverage.wrapping_add(o.coverage);
+        self.weight = self.weight.saturating_add(o.weight);
+        self.coverage = self.coverage.saturating_add(o.coverage);
     }
 
     /// The pixel's value: weighted mean radiance and coverage, (0, 0, 0, 0) with no weight.
@@ -247,6 +248,29 @@ pub(crate) mod tests {
         assert_eq!(to_fixed(f32::MAX), i128::MAX);
         assert_eq!(to_fixed(f32::MIN), i128::MIN);
         assert_eq!(from_fixed(3i128 << 62), 0.75);
+    }
+
+    #[test]
+    fn sums_past_the_range_saturate_in_any_order() {
+        let big = PixelSums {
+            radiance: [i128::MAX - 5, 7, i128::MIN + 1],
+            weight: 1 << 64,
+            coverage: 0,
+        };
+        let more = PixelSums {
+            radiance: [10, 1, -3],
+            weight: 1 << 64,
+            coverage: 1,
+        };
+        let (mut a, mut b) = (big, more);
+        a.add(&more);
+        a.add(&more);
+        b.add(&more);
+        b.add(&big);
+        assert_eq!(a, b);
+        assert_eq!(a.radiance, [i128::MAX, 9, i128::MIN]);
+        let [r, _, bl, _] = a.resolve();
+        assert!(r > 1e18 && r.is_finite() && bl < -1e18 && bl.is_finite());
     }
 
     /// A pass of random samples over a `w x h` film with a Gaussian filter (margins overlap
