@@ -2,6 +2,7 @@
 //! fail, the command line's contract (exit status, messages, atomic output), determinism.
 
 mod cli;
+mod deploy;
 mod gallery;
 mod opencv;
 mod robust;
