@@ -181,6 +181,7 @@ impl Interrupts {
 }
 
 fn run_render(args: RenderArgs) -> Result<ExitCode, RenderError> {
+    let started = Instant::now();
     let scene_path = args.scene_path.as_path();
     let slice = match &args.slice {
         Some(text) => Some(Slice::parse(
@@ -296,7 +297,7 @@ fn run_render(args: RenderArgs) -> Result<ExitCode, RenderError> {
                 "a stereo camera renders two views; slice a single view",
             ));
         }
-        return render_slice(scene_path, description, slice, &output, threads);
+        return render_slice(scene_path, description, slice, &output, threads, started);
     }
     if let Some(views) = plan_views(&description, args.cube_map, &output) {
         if args.checkpoint.is_some() || args.resume.is_some() {
@@ -478,19 +479,20 @@ fn scene_source(scene_path: &Path) -> Result<Vec<u8>, RenderError> {
 }
 
 /// Renders one slice of the scene and writes its partial film to `output`, whole or not at
-/// all. An interrupt writes nothing.
+/// all. An interrupt writes nothing. `started`: when the command started, for the set-up time
+/// (parse, build) it reports.
 fn render_slice(
     scene_path: &Path,
     description: SceneDescription,
     slice: Slice,
     output: &Path,
     threads: Option<usize>,
+    started: Instant,
 ) -> Result<ExitCode, RenderError> {
-    let start = Instant::now();
     let fingerprint = scene_fingerprint(&scene_source(scene_path)?, &description);
     let scene = RenderScene::build(description)?;
     report_skipped(&scene);
-    let setup = start.elapsed();
+    let setup = started.elapsed();
     let spp = scene.sampler.samples_per_pixel();
     let tile_count = obscura_render::tiles(scene.pixel_bounds).len();
     let (passes, tiles, what) = match slice.by {
@@ -538,15 +540,17 @@ fn render_slice(
         slice,
         film: outcome.film,
     };
+    let written = Instant::now();
     partial.save(output)?;
     println!(
-        "rendered slice {slice} of {} -> {}: {what}, {} integrator, {:.2} M samples; set-up (parse, build) {:.3} s, render {:.3} s",
+        "rendered slice {slice} of {} -> {}: {what}, {} integrator, {:.2} M samples; set-up (parse, build) {:.3} s, render {:.3} s, write {:.3} s",
         scene_path.display(),
         output.display(),
         scene.integrator().name(),
         outcome.stats.samples as f64 / 1e6,
         setup.as_secs_f64(),
         outcome.elapsed.as_secs_f64(),
+        written.elapsed().as_secs_f64(),
     );
     Ok(ExitCode::SUCCESS)
 }

@@ -104,7 +104,7 @@ wait_for 30 bash -c "sinfo -h -o %T | grep -q idle"
 sinfo
 
 scene="$repo/scenes/cornell-box.toml"
-flags="--resolution ${RES:-160x120} --spp ${SPP:-48}"
+flags="--resolution ${RES:-320x240} --spp ${SPP:-64}"
 say "== one-machine render: obscura render cornell-box.toml $flags --threads $(nproc)"
 # shellcheck disable=SC2086
 "$OBSCURA" render "$scene" $flags --threads "$(nproc)" -o "$work/one.exr"
@@ -135,6 +135,9 @@ scontrol requeue "${array}_3"
 say "== wait for the rounds to finish"
 wait_for 600 bash -c '[ -z "$(squeue -h)" ]'
 squeue -t all -o "%.8i %.16j %.10T %.24r %E" | sort -n
+for t in 1 3; do
+  say "task ${array}_$t: $(scontrol show job "${array}_$t" | grep -o 'JobState=[A-Z]* \|Restarts=[0-9]*\|ExitCode=[0-9:]*' | tr '\n' ' ')"
+done
 for f in "$work"/shared/obscura-*.out; do
   say "--- $(basename "$f")"
   cat "$f"

@@ -383,6 +383,18 @@ mod tests {
     }
 
     #[test]
+    fn a_version_1_checkpoint_of_f64_sums_is_refused_by_its_version() {
+        let mut bytes = sample_checkpoint(2, 1, 4).to_bytes();
+        bytes[8..12].copy_from_slice(&1u32.to_le_bytes());
+        let e = Checkpoint::from_bytes(&bytes, Path::new("old.ckpt")).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("format version 1, this obscura reads version 2"),
+            "{e}"
+        );
+    }
+
+    #[test]
     fn a_checkpoint_from_other_settings_is_refused() {
         let c = sample_checkpoint(2, 2, 3);
         let file = Path::new("c.ckpt");
