@@ -200,8 +200,7 @@ pub fn render(
                     return;
                 }
                 let pass = first_pass + (m.cursor / tile_count) as u32;
-                m.film.add(&m.pass_film);
-                m.pass_film.clear();
+                m.film.absorb(&mut m.pass_film);
                 m.passes_done = pass;
                 if let Some(f) = on_pass {
                     f(pass, end_pass, &m.film);
