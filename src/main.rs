@@ -5,7 +5,7 @@ use obscura_camera::CubeFace;
 use obscura_render::{
     CameraKind, Checkpoint, Film, ImageInfo, IntegratorKind, OutputFormat, Partial, RenderError,
     RenderOptions, RenderScene, SceneDescription, Slice, SliceBy, StereoLayout, compose_stereo,
-    load_description, read_partials, render, scene_fingerprint, write_image,
+    load_description, merge_partials, render, scene_fingerprint, write_image,
 };
 use signal_hook::consts::{SIGINT, SIGTERM};
 use std::io::IsTerminal;
@@ -581,8 +581,8 @@ fn run_merge(args: MergeArgs) -> Result<ExitCode, RenderError> {
                 "no readable part says how many slices there are; give --slices N",
             ));
         }
-        let (_, missing) = read_partials(&readable, args.slices)?;
-        let list: Vec<String> = missing.iter().map(u32::to_string).collect();
+        let set = merge_partials(&readable, args.slices)?;
+        let list: Vec<String> = set.missing.iter().map(u32::to_string).collect();
         println!("{}", list.join(","));
         return Ok(ExitCode::SUCCESS);
     }
@@ -594,9 +594,13 @@ fn run_merge(args: MergeArgs) -> Result<ExitCode, RenderError> {
         return Err(setting("merge", "no parts given"));
     }
     let start = Instant::now();
-    let (parts, missing) = read_partials(&args.parts, args.slices)?;
-    let first = &parts[0];
-    if !missing.is_empty() {
+    let set = merge_partials(&args.parts, args.slices)?;
+    let Some(merged) = set.merged else {
+        return Err(setting("merge", "no parts given"));
+    };
+    let first = &merged;
+    if !set.missing.is_empty() {
+        let missing = &set.missing;
         let list: Vec<String> = missing.iter().map(u32::to_string).collect();
         return Err(setting(
             "merge",
@@ -611,18 +615,17 @@ fn run_merge(args: MergeArgs) -> Result<ExitCode, RenderError> {
         ));
     }
     let read = start.elapsed();
-    let film = obscura_render::merge(&parts).unwrap_or_else(|| Film::new(first.film.bounds()));
     write_image(
         &output,
-        &film.resolve(),
+        &merged.film.resolve(),
         &ImageInfo {
             partial: false,
             samples_per_pixel: first.samples_per_pixel,
         },
     )?;
     println!(
-        "merged {} slices by {} -> {}: {}x{}, {} spp, {} integrator; read {:.3} s, merge and write {:.3} s",
-        parts.len(),
+        "merged {} slices by {} -> {}: {}x{}, {} spp, {} integrator; read and add {:.3} s, write {:.3} s",
+        set.present.len(),
         first.slice.by.name(),
         output.display(),
         first.resolution[0],

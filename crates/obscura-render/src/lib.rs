@@ -17,7 +17,7 @@
 //! accumulator that is added to the film once the pass is complete, and the film's sums are
 //! exact fixed-point integers. So the image is bit-identical for any thread count and any tile
 //! completion order, and a render split into slices of passes or tiles ([`Slice`], written as
-//! [`Partial`] files) [`merge`]s to exactly the one-process image.
+//! [`Partial`] files) merges ([`merge_partials`]) to exactly the one-process image.
 //!
 //! Not for: camera models, BVHs or BSDFs themselves (their crates), nor the command line (the
 //! `camera-obscura` package's `obscura` binary).
@@ -67,7 +67,9 @@ pub use checkpoint::{CHECKPOINT_MAGIC, CHECKPOINT_VERSION, Checkpoint, scene_fin
 pub use error::RenderError;
 pub use film::{FIXED_FRACTION_BITS, Film, Filter, Image, PixelRect, PixelSums, TileBuffer};
 pub use output::{ImageInfo, OutputFormat, read_exr, srgb_8bit, temporary_beside, write_image};
-pub use partial::{PARTIAL_MAGIC, PARTIAL_VERSION, Partial, Slice, SliceBy, merge, read_partials};
+pub use partial::{
+    PARTIAL_MAGIC, PARTIAL_VERSION, PartSet, Partial, Slice, SliceBy, merge_partials,
+};
 pub use postprocess::{
     DepthOfField, ScreenBuffers, circle_of_confusion, circle_of_confusion_orthographic,
     depth_of_field, motion_blur, screen_buffers,

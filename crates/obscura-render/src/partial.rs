@@ -343,68 +343,76 @@ impl Partial {
     }
 }
 
-/// Reads the partials and checks that they are one render's slices: the same render (scene,
-/// seed, spp, integrator, resolution, slicing), each slice once. Returns them with the
-/// indices of the slices missing from `0..count`; `expected` is the slice count asked for,
-/// if any. Errors name the file at fault.
-pub fn read_partials(
-    paths: &[PathBuf],
-    expected: Option<u32>,
-) -> Result<(Vec<Partial>, Vec<u32>), RenderError> {
-    let mut parts: Vec<(Partial, &PathBuf)> = Vec::with_capacity(paths.len());
-    for path in paths {
-        let part = Partial::load(path)?;
-        if let Some((first, first_path)) = parts.first() {
-            if let Some(why) = first.mismatch(&part) {
-                return Err(RenderError::Partial {
-                    file: path.clone(),
-                    message: format!(
-                        "not a slice of the same render as {}: {why}",
-                        first_path.display()
-                    ),
-                });
-            }
-        } else if let Some(n) = expected.filter(|&n| n != part.slice.count) {
-            return Err(RenderError::Partial {
-                file: path.clone(),
-                message: format!("a slice of {}, not of {n}", part.slice.count),
-            });
-        }
-        if let Some((_, other)) = parts
-            .iter()
-            .find(|(p, _)| p.slice.index == part.slice.index)
-        {
-            return Err(RenderError::Partial {
-                file: path.clone(),
-                message: format!(
-                    "duplicate: slice {} is also in {}",
-                    part.slice,
-                    other.display()
-                ),
-            });
-        }
-        parts.push((part, path));
-    }
-    let count = parts
-        .first()
-        .map_or(expected.unwrap_or(0), |p| p.0.slice.count);
-    let missing = (0..count)
-        .filter(|i| !parts.iter().any(|(p, _)| p.slice.index == *i))
-        .collect();
-    let mut parts: Vec<Partial> = parts.into_iter().map(|(p, _)| p).collect();
-    parts.sort_by_key(|p| p.slice.index);
-    Ok((parts, missing))
+/// The result of reading a set of parts: what [`merge_partials`] found.
+#[derive(Debug)]
+pub struct PartSet {
+    /// The first part read, its film replaced by the sum of every part's film (the whole
+    /// render's film once no slice is missing); `None` when no part was given.
+    pub merged: Option<Partial>,
+    /// The slice indices read, ascending.
+    pub present: Vec<u32>,
+    /// The indices of `0..count` without a part, ascending.
+    pub missing: Vec<u32>,
 }
 
-/// Adds every slice's film: the film of the whole render, exactly. The partials must be one
-/// render's complete set (as [`read_partials`] checks); `None` for an empty set.
-pub fn merge(parts: &[Partial]) -> Option<Film> {
-    let first = parts.first()?;
-    let mut film = Film::new(first.film.bounds());
-    for p in parts {
-        film.add(&p.film);
+/// Reads the parts one at a time and adds their films, checking that they are one render's
+/// slices: the same render (scene, seed, spp, integrator, resolution, slicing), each slice at
+/// most once. `expected` is the slice count asked for, if any. Errors name the file at fault.
+/// Memory holds two films whatever the number of parts: the sum and the part being read.
+/// The sums are exact, so the order of `paths` does not matter.
+pub fn merge_partials(paths: &[PathBuf], expected: Option<u32>) -> Result<PartSet, RenderError> {
+    let mut merged: Option<(Partial, &PathBuf)> = None;
+    let mut present: Vec<(u32, &PathBuf)> = Vec::with_capacity(paths.len());
+    for path in paths {
+        let part = Partial::load(path)?;
+        let refuse = |message: String| RenderError::Partial {
+            file: path.clone(),
+            message,
+        };
+        match &merged {
+            Some((first, first_path)) => {
+                if let Some(why) = first.mismatch(&part) {
+                    return Err(refuse(format!(
+                        "not a slice of the same render as {}: {why}",
+                        first_path.display()
+                    )));
+                }
+            }
+            None => {
+                if let Some(n) = expected.filter(|&n| n != part.slice.count) {
+                    return Err(refuse(format!(
+                        "a slice of {}, not of {n}",
+                        part.slice.count
+                    )));
+                }
+            }
+        }
+        if let Some((_, other)) = present.iter().find(|(i, _)| *i == part.slice.index) {
+            return Err(refuse(format!(
+                "duplicate: slice {} is also in {}",
+                part.slice,
+                other.display()
+            )));
+        }
+        present.push((part.slice.index, path));
+        match &mut merged {
+            Some((sum, _)) => sum.film.add(&part.film),
+            None => merged = Some((part, path)),
+        }
     }
-    Some(film)
+    let count = merged
+        .as_ref()
+        .map_or(expected.unwrap_or(0), |(p, _)| p.slice.count);
+    let mut present: Vec<u32> = present.into_iter().map(|(i, _)| i).collect();
+    present.sort_unstable();
+    let missing = (0..count)
+        .filter(|i| present.binary_search(i).is_err())
+        .collect();
+    Ok(PartSet {
+        merged: merged.map(|(p, _)| p),
+        present,
+        missing,
+    })
 }
 
 #[cfg(test)]
