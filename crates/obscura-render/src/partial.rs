@@ -4,8 +4,8 @@
 //! Slice `i` of `N` takes a contiguous share of the passes (sample indices; the default) or of
 //! the tiles, and writes a [`Partial`]: its film's fixed-point sums with a header that says
 //! which render and which slice they belong to. Because the film's sums are integers,
-//! [`merge`] adds the `N` partials in any order to exactly the film that one process would
-//! have made (see docs/ARCHITECTURE.md, "Slices and the exact merge").
+//! [`merge_partials`] adds the `N` partials in any order to exactly the film that one process
+//! would have made (see docs/ARCHITECTURE.md, "Slices and the exact merge").
 //!
 //! The format follows the checkpoint's (little-endian, the same sums and checksum):
 //!
