@@ -124,9 +124,12 @@ task_pid() { # the obscura process of array task $1, once it runs
   done
   return 1
 }
+cpu_ticks() { awk '{ print $14 + $15 }' "/proc/$1/stat"; } # user + system, 1/100 s
 wait_for 60 task_pid 1
 pid=$(task_pid 1)
-say "task ${array}_1 runs obscura as pid $pid; killing it mid-way (SIGKILL)"
+# Mid-way: once it has rendered for a second of CPU (a slice takes about three).
+wait_for 60 bash -c "[ \$(awk '{ print \$14 + \$15 }' /proc/$pid/stat) -ge 100 ]"
+say "task ${array}_1 runs obscura as pid $pid, $(cpu_ticks "$pid")/100 CPU s in; killing it (SIGKILL)"
 kill -KILL "$pid"
 wait_for 120 bash -c "squeue -h -t R -j ${array}_3 | grep -q ."
 say "task ${array}_3 runs; scontrol requeue (as a preemption would): Slurm runs it again"
