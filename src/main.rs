@@ -4,9 +4,9 @@ use clap::{Parser, Subcommand};
 use obscura_camera::CubeFace;
 use obscura_import::Imported;
 use obscura_render::{
-    CameraKind, Checkpoint, Film, ImageInfo, IntegratorKind, OutputFormat, RenderError,
-    RenderOptions, RenderScene, SceneDescription, StereoLayout, compose_stereo, load_description,
-    render, scene_fingerprint, write_image,
+    CameraKind, Checkpoint, Film, ImageInfo, IntegratorKind, OutputFormat, Partial, RenderError,
+    RenderOptions, RenderScene, SceneDescription, Slice, SliceBy, StereoLayout, compose_stereo,
+    load_description, merge_partials, render, scene_fingerprint, write_image,
 };
 use signal_hook::consts::{SIGINT, SIGTERM};
 use std::io::IsTerminal;
@@ -48,6 +48,28 @@ enum Command {
         #[arg(short = 'o', long = "output")]
         output: Option<PathBuf>,
     },
+    /// Merge the partial films of `obscura render --slice i/N` into the image a single render
+    /// makes, bit for bit.
+    Merge(MergeArgs),
+}
+
+/// The `merge` subcommand's arguments.
+#[derive(clap::Args)]
+struct MergeArgs {
+    /// The partial files, one per slice, in any order.
+    #[arg(value_name = "PARTS")]
+    parts: Vec<PathBuf>,
+    /// Output image, .exr or .png
+    #[arg(short = 'o', long = "output", required_unless_present = "list_missing")]
+    output: Option<PathBuf>,
+    /// Print the indices of the slices missing from PARTS, comma-separated on one line (empty
+    /// when none is), and write nothing; unreadable or corrupt parts count as missing
+    #[arg(long)]
+    list_missing: bool,
+    /// The number of slices N [default: as the parts say]; needed by --list-missing when no
+    /// part is readable
+    #[arg(long, value_name = "N")]
+    slices: Option<u32>,
 }
 
 fn main() -> ExitCode {
@@ -58,6 +80,7 @@ fn main() -> ExitCode {
         Command::Convert { scene, output } => {
             run_convert(&scene, output).map(|()| ExitCode::SUCCESS)
         }
+        Command::Merge(args) => run_merge(args),
     };
     match result {
         Ok(code) => code,
@@ -112,6 +135,14 @@ struct RenderArgs {
     /// OUT-px, OUT-nx, OUT-py, OUT-ny, OUT-pz, OUT-nz (OpenGL order; the film must be square)
     #[arg(long)]
     cube_map: bool,
+    /// Render only slice i of N (0 <= i < N) and write its partial film to -o PART, for
+    /// `obscura merge`
+    #[arg(long, value_name = "i/N")]
+    slice: Option<String>,
+    /// What --slice splits: passes (sample indices; each slice covers the whole image) or
+    /// tiles (each slice takes every sample of its share of the image)
+    #[arg(long, value_name = "KIND", default_value = "passes", value_parser = ["passes", "tiles"])]
+    slice_by: String,
 }
 
 /// SIGINT and SIGTERM handling: the first sets `cancel` (the render stops at the next pass
@@ -163,11 +194,27 @@ impl Interrupts {
 }
 
 fn run_render(args: RenderArgs) -> Result<ExitCode, RenderError> {
+    let started = Instant::now();
     let scene_path = args.scene_path.as_path();
+    let slice = match &args.slice {
+        Some(text) => Some(Slice::parse(
+            text,
+            SliceBy::parse(&args.slice_by).unwrap_or(SliceBy::Passes),
+        )?),
+        None => None,
+    };
+    if slice.is_some() && args.output.is_none() {
+        return Err(setting(
+            "--slice",
+            "needs -o PART, the partial file to write",
+        ));
+    }
     let output = args
         .output
         .unwrap_or_else(|| scene_path.with_extension("exr"));
-    OutputFormat::from_path(&output)?;
+    if slice.is_none() {
+        OutputFormat::from_path(&output)?;
+    }
     let folder = match output.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
@@ -241,6 +288,30 @@ fn run_render(args: RenderArgs) -> Result<ExitCode, RenderError> {
     for note in &description.ignored {
         eprintln!("note: {note}");
     }
+    if let Some(slice) = slice {
+        let refused = if args.checkpoint.is_some() {
+            Some("--checkpoint")
+        } else if args.resume.is_some() {
+            Some("--resume")
+        } else if args.cube_map {
+            Some("--cube-map")
+        } else {
+            None
+        };
+        if let Some(name) = refused {
+            return Err(setting(
+                name,
+                "cannot be combined with --slice (a slice is re-rendered whole if it fails)",
+            ));
+        }
+        if description.camera.stereo.is_some() {
+            return Err(setting(
+                "--slice",
+                "a stereo camera renders two views; slice a single view",
+            ));
+        }
+        return render_slice(scene_path, description, slice, &output, threads, started);
+    }
     if let Some(views) = plan_views(&description, args.cube_map, &output) {
         if args.checkpoint.is_some() || args.resume.is_some() {
             return Err(setting(
@@ -256,12 +327,7 @@ fn run_render(args: RenderArgs) -> Result<ExitCode, RenderError> {
     }
     // The checkpoint's fingerprint: the scene file's bytes and the settings after overrides.
     let fingerprint = if args.checkpoint.is_some() || args.resume.is_some() {
-        let source = std::fs::read(scene_path).map_err(|source| RenderError::Io {
-            file: scene_path.to_path_buf(),
-            action: "cannot read the scene file",
-            source,
-        })?;
-        scene_fingerprint(&source, &description)
+        scene_fingerprint(&scene_source(scene_path)?, &description)
     } else {
         0
     };
@@ -336,6 +402,7 @@ fn run_render(args: RenderArgs) -> Result<ExitCode, RenderError> {
             on_pass: Some(&on_pass),
             on_tile: Some(&on_tile),
             resume,
+            ..Default::default()
         },
     )
     .map_err(|e| setting("--threads", format!("cannot start the worker threads: {e}")))?;
@@ -412,6 +479,175 @@ fn run_render(args: RenderArgs) -> Result<ExitCode, RenderError> {
         ));
     }
     println!("{summary}");
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Reads the scene file's bytes, for the fingerprint of checkpoints and partials.
+fn scene_source(scene_path: &Path) -> Result<Vec<u8>, RenderError> {
+    std::fs::read(scene_path).map_err(|source| RenderError::Io {
+        file: scene_path.to_path_buf(),
+        action: "cannot read the scene file",
+        source,
+    })
+}
+
+/// Renders one slice of the scene and writes its partial film to `output`, whole or not at
+/// all. An interrupt writes nothing. `started`: when the command started, for the set-up time
+/// (parse, build) it reports.
+fn render_slice(
+    scene_path: &Path,
+    description: SceneDescription,
+    slice: Slice,
+    output: &Path,
+    threads: Option<usize>,
+    started: Instant,
+) -> Result<ExitCode, RenderError> {
+    let fingerprint = scene_fingerprint(&scene_source(scene_path)?, &description);
+    let scene = RenderScene::build(description)?;
+    report_skipped(&scene);
+    let setup = started.elapsed();
+    let spp = scene.sampler.samples_per_pixel();
+    let tile_count = obscura_render::tiles(scene.pixel_bounds).len();
+    let (passes, tiles, what) = match slice.by {
+        SliceBy::Passes => {
+            let r = slice.range(u64::from(spp));
+            let r = r.start as u32..r.end as u32;
+            let what = format!("passes {}..{} of {spp}", r.start, r.end);
+            (r, None, what)
+        }
+        SliceBy::Tiles => {
+            let r = slice.range(tile_count as u64);
+            let r = r.start as usize..r.end as usize;
+            let what = format!("tiles {}..{} of {tile_count}", r.start, r.end);
+            (0..spp, Some(r), what)
+        }
+    };
+    let end = passes.end;
+    let interrupts = Interrupts::install()?;
+    let outcome = render(
+        &scene,
+        RenderOptions {
+            threads,
+            cancel: Some(&interrupts.cancel),
+            passes: Some(passes),
+            tiles,
+            ..Default::default()
+        },
+    )
+    .map_err(|e| setting("--threads", format!("cannot start the worker threads: {e}")))?;
+    if outcome.passes_done < end {
+        let signal = interrupts.received().unwrap_or(SIGINT);
+        eprintln!(
+            "interrupted: slice {slice} not written ({} left as it was)",
+            output.display()
+        );
+        return Ok(ExitCode::from(128 + signal as u8));
+    }
+    let d = &scene.description;
+    let partial = Partial {
+        fingerprint,
+        seed: d.sampler.seed,
+        samples_per_pixel: spp,
+        integrator: scene.integrator(),
+        resolution: d.film.resolution,
+        slice,
+        film: outcome.film,
+    };
+    let written = Instant::now();
+    partial.save(output)?;
+    println!(
+        "rendered slice {slice} of {} -> {}: {what}, {} integrator, {:.2} M samples; set-up (parse, build) {:.3} s, render {:.3} s, write {:.3} s",
+        scene_path.display(),
+        output.display(),
+        scene.integrator().name(),
+        outcome.stats.samples as f64 / 1e6,
+        setup.as_secs_f64(),
+        outcome.elapsed.as_secs_f64(),
+        written.elapsed().as_secs_f64(),
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `obscura merge`: checks that the parts are one render's slices, each once, and writes the
+/// image; or, with --list-missing, prints the slices still to render.
+fn run_merge(args: MergeArgs) -> Result<ExitCode, RenderError> {
+    if args.slices == Some(0) {
+        return Err(setting("--slices", "must be >= 1, got 0"));
+    }
+    if args.list_missing {
+        // A part that cannot be read is as good as missing: its slice must be rendered again.
+        let readable: Vec<PathBuf> = args
+            .parts
+            .iter()
+            .filter(|p| match Partial::load(p) {
+                Ok(_) => true,
+                Err(e) => {
+                    eprintln!("note: counted as missing: {e}");
+                    false
+                }
+            })
+            .cloned()
+            .collect();
+        if readable.is_empty() && args.slices.is_none() {
+            return Err(setting(
+                "--list-missing",
+                "no readable part says how many slices there are; give --slices N",
+            ));
+        }
+        let set = merge_partials(&readable, args.slices)?;
+        let list: Vec<String> = set.missing.iter().map(u32::to_string).collect();
+        println!("{}", list.join(","));
+        return Ok(ExitCode::SUCCESS);
+    }
+    let Some(output) = args.output else {
+        return Err(setting("-o", "merge needs -o OUT.exr or OUT.png"));
+    };
+    OutputFormat::from_path(&output)?;
+    if args.parts.is_empty() {
+        return Err(setting("merge", "no parts given"));
+    }
+    let start = Instant::now();
+    let set = merge_partials(&args.parts, args.slices)?;
+    let Some(merged) = set.merged else {
+        return Err(setting("merge", "no parts given"));
+    };
+    let first = &merged;
+    if !set.missing.is_empty() {
+        let missing = &set.missing;
+        let list: Vec<String> = missing.iter().map(u32::to_string).collect();
+        return Err(setting(
+            "merge",
+            format!(
+                "missing {} of {} slices: {} (render them with --slice i/{} --slice-by {}); wrote nothing",
+                missing.len(),
+                first.slice.count,
+                list.join(", "),
+                first.slice.count,
+                first.slice.by.name()
+            ),
+        ));
+    }
+    let read = start.elapsed();
+    write_image(
+        &output,
+        &merged.film.resolve(),
+        &ImageInfo {
+            partial: false,
+            samples_per_pixel: first.samples_per_pixel,
+        },
+    )?;
+    println!(
+        "merged {} slices by {} -> {}: {}x{}, {} spp, {} integrator; read and add {:.3} s, write {:.3} s",
+        set.present.len(),
+        first.slice.by.name(),
+        output.display(),
+        first.resolution[0],
+        first.resolution[1],
+        first.samples_per_pixel,
+        first.integrator.name(),
+        read.as_secs_f64(),
+        (start.elapsed() - read).as_secs_f64(),
+    );
     Ok(ExitCode::SUCCESS)
 }
 

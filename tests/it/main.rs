@@ -2,6 +2,7 @@
 //! fail, the command line's contract (exit status, messages, atomic output), determinism.
 
 mod cli;
+mod deploy;
 mod gallery;
 mod import;
 mod opencv;
@@ -10,6 +11,7 @@ mod py_fixture;
 mod realistic;
 mod robust;
 mod scenes;
+mod slices;
 mod soak;
 mod views;
 

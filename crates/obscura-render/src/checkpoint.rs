@@ -10,13 +10,16 @@
 //! spp          u32      samples per pixel the render is going to
 //! passes_done  u32      complete passes in the sums (<= spp)
 //! bounds       4 x u32  x0, y0, x1, y1 of the film's pixel bounds
-//! sums         (x1 - x0) (y1 - y0) x 5 f64: radiance r, g, b, weight, coverage, row by row
+//! sums         (x1 - x0) (y1 - y0) x 5 i128: radiance r, g, b, weight, coverage, row by row
 //! checksum     u64      FNV-1a of every byte before it
 //! ```
 //!
 //! A render is a fixed sequence of passes (pass `k` takes sample `k` of every pixel) and the sums
-//! are f64 written bit for bit, so continuing from a checkpoint adds exactly what the
-//! uninterrupted render would have added.
+//! are the film's exact fixed-point integers ([`PixelSums`]), so continuing from a checkpoint
+//! adds exactly what the uninterrupted render would have added. Version 1 held f64 sums, which
+//! this build's films no longer keep; such checkpoints are refused by their version.
+//!
+//! A slice's partial film ([`crate::Partial`]) uses the same sums and checksum.
 
 use crate::error::RenderError;
 use crate::film::{Film, PixelRect, PixelSums};
@@ -29,7 +32,7 @@ use std::path::Path;
 pub const CHECKPOINT_MAGIC: [u8; 8] = *b"OBSCKPT\0";
 
 /// The format version this build reads and writes.
-pub const CHECKPOINT_VERSION: u32 = 1;
+pub const CHECKPOINT_VERSION: u32 = 2;
 
 /// Bytes before the sums: magic, version, fingerprint, spp, passes, bounds.
 const HEADER_BYTES: usize = 8 + 4 + 8 + 4 + 4 + 16;
@@ -78,7 +81,7 @@ impl Checkpoint {
     pub fn to_bytes(&self) -> Vec<u8> {
         let b = self.film.bounds();
         let sums = self.film.sums();
-        let mut out = Vec::with_capacity(HEADER_BYTES + sums.len() * 40 + 8);
+        let mut out = Vec::with_capacity(HEADER_BYTES + sums.len() * SUM_BYTES + 8);
         out.extend_from_slice(&CHECKPOINT_MAGIC);
         out.extend_from_slice(&CHECKPOINT_VERSION.to_le_bytes());
         out.extend_from_slice(&self.fingerprint.to_le_bytes());
@@ -87,19 +90,8 @@ impl Checkpoint {
         for v in [b.x0, b.y0, b.x1, b.y1] {
             out.extend_from_slice(&v.to_le_bytes());
         }
-        for s in sums {
-            for v in [
-                s.radiance[0],
-                s.radiance[1],
-                s.radiance[2],
-                s.weight,
-                s.coverage,
-            ] {
-                out.extend_from_slice(&v.to_le_bytes());
-            }
-        }
-        let checksum = fnv1a(FNV_OFFSET, &out);
-        out.extend_from_slice(&checksum.to_le_bytes());
+        put_sums(&mut out, sums);
+        seal(&mut out);
         out
     }
 
@@ -141,37 +133,13 @@ impl Checkpoint {
                 "corrupt: pixel bounds {bounds:?} are reversed"
             )));
         }
-        let expected = (bounds.area() as u128) * 40 + HEADER_BYTES as u128 + 8;
-        if bytes.len() as u128 != expected {
-            return Err(bad(format!(
-                "truncated or corrupt: {} bytes, expected {expected} for {}x{} pixels",
-                bytes.len(),
-                bounds.width(),
-                bounds.height()
-            )));
-        }
-        let body = bytes.len() - 8;
-        let stored = u64::from_le_bytes(bytes[body..].try_into().unwrap_or_default());
-        if stored != fnv1a(FNV_OFFSET, &bytes[..body]) {
-            return Err(bad(
-                "corrupt: the checksum does not match the contents".into()
-            ));
-        }
+        check_length_and_checksum(bytes, HEADER_BYTES, bounds).map_err(bad)?;
         if passes_done > samples_per_pixel {
             return Err(bad(format!(
                 "corrupt: {passes_done} passes done of {samples_per_pixel}"
             )));
         }
-        let mut sums = Vec::with_capacity(bounds.area() as usize);
-        while reader.at < body {
-            sums.push(PixelSums {
-                radiance: [reader.f64(), reader.f64(), reader.f64()],
-                weight: reader.f64(),
-                coverage: reader.f64(),
-            });
-        }
-        let film = Film::from_sums(bounds, sums)
-            .ok_or_else(|| bad("corrupt: the pixel count does not match the bounds".into()))?;
+        let film = take_film(&mut reader, bounds).map_err(bad)?;
         Ok(Checkpoint {
             fingerprint,
             samples_per_pixel,
@@ -251,10 +219,73 @@ impl Checkpoint {
     }
 }
 
+/// Bytes of one pixel's sums in a file: five i128.
+pub(crate) const SUM_BYTES: usize = 5 * 16;
+
+/// Appends the sums, row by row, five little-endian i128 each.
+pub(crate) fn put_sums(out: &mut Vec<u8>, sums: &[PixelSums]) {
+    for s in sums {
+        for v in [
+            s.radiance[0],
+            s.radiance[1],
+            s.radiance[2],
+            s.weight,
+            s.coverage,
+        ] {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+}
+
+/// Appends the FNV-1a checksum of everything in `out`.
+pub(crate) fn seal(out: &mut Vec<u8>) {
+    let checksum = fnv1a(FNV_OFFSET, out);
+    out.extend_from_slice(&checksum.to_le_bytes());
+}
+
+/// `Ok` when `bytes` is exactly a header of `header` bytes, the sums of `bounds` and a
+/// matching checksum; otherwise what is wrong (truncated, padded or corrupt).
+pub(crate) fn check_length_and_checksum(
+    bytes: &[u8],
+    header: usize,
+    bounds: PixelRect,
+) -> Result<(), String> {
+    let expected = u128::from(bounds.area()) * SUM_BYTES as u128 + header as u128 + 8;
+    if bytes.len() as u128 != expected {
+        return Err(format!(
+            "truncated or corrupt: {} bytes, expected {expected} for {}x{} pixels",
+            bytes.len(),
+            bounds.width(),
+            bounds.height()
+        ));
+    }
+    let body = bytes.len() - 8;
+    let stored = u64::from_le_bytes(bytes[body..].try_into().unwrap_or_default());
+    if stored != fnv1a(FNV_OFFSET, &bytes[..body]) {
+        return Err("corrupt: the checksum does not match the contents".into());
+    }
+    Ok(())
+}
+
+/// Reads the sums of `bounds` (the length was checked by [`check_length_and_checksum`]).
+pub(crate) fn take_film(reader: &mut Reader<'_>, bounds: PixelRect) -> Result<Film, String> {
+    let body = reader.bytes.len() - 8;
+    let mut sums = Vec::with_capacity(bounds.area() as usize);
+    while reader.at < body {
+        sums.push(PixelSums {
+            radiance: [reader.i128(), reader.i128(), reader.i128()],
+            weight: reader.i128(),
+            coverage: reader.i128(),
+        });
+    }
+    Film::from_sums(bounds, sums)
+        .ok_or_else(|| "corrupt: the pixel count does not match the bounds".into())
+}
+
 /// Reads little-endian numbers; callers have checked the length first.
-struct Reader<'a> {
-    bytes: &'a [u8],
-    at: usize,
+pub(crate) struct Reader<'a> {
+    pub(crate) bytes: &'a [u8],
+    pub(crate) at: usize,
 }
 
 impl Reader<'_> {
@@ -266,14 +297,17 @@ impl Reader<'_> {
         self.at += N;
         out
     }
-    fn u32(&mut self) -> u32 {
+    pub(crate) fn bytes<const N: usize>(&mut self) -> [u8; N] {
+        self.take()
+    }
+    pub(crate) fn u32(&mut self) -> u32 {
         u32::from_le_bytes(self.take())
     }
-    fn u64(&mut self) -> u64 {
+    pub(crate) fn u64(&mut self) -> u64 {
         u64::from_le_bytes(self.take())
     }
-    fn f64(&mut self) -> f64 {
-        f64::from_le_bytes(self.take())
+    fn i128(&mut self) -> i128 {
+        i128::from_le_bytes(self.take())
     }
 }
 
@@ -291,11 +325,11 @@ mod tests {
         };
         let sums = (0..u64::from(w * h))
             .map(|i| {
-                let v = (i ^ seed) as f64;
+                let v = i128::from(i ^ seed);
                 PixelSums {
-                    radiance: [v * 0.1, -v, f64::MIN_POSITIVE * v],
-                    weight: v + 0.5,
-                    coverage: 1.0 / (v + 3.0),
+                    radiance: [v * 3, -v, i128::MIN + v],
+                    weight: v << 64,
+                    coverage: i128::MAX - v,
                 }
             })
             .collect();
@@ -311,15 +345,19 @@ mod tests {
     fn header_layout_is_as_documented() {
         let c = sample_checkpoint(2, 1, 7);
         let bytes = c.to_bytes();
-        // 44 header bytes + 2 pixels x 5 f64 + 8 checksum bytes = 44 + 80 + 8 = 132.
-        assert_eq!(bytes.len(), 132);
+        // 44 header bytes + 2 pixels x 5 i128 + 8 checksum bytes = 44 + 160 + 8 = 212.
+        assert_eq!(bytes.len(), 212);
         assert_eq!(&bytes[..8], b"OBSCKPT\0");
-        assert_eq!(bytes[8..12], 1u32.to_le_bytes());
+        assert_eq!(bytes[8..12], 2u32.to_le_bytes());
         assert_eq!(bytes[20..24], 16u32.to_le_bytes());
         assert_eq!(bytes[24..28], 5u32.to_le_bytes());
         // Bounds 1, 2, 3, 3.
         assert_eq!(bytes[28..32], 1u32.to_le_bytes());
         assert_eq!(bytes[40..44], 3u32.to_le_bytes());
+        // The first pixel's red sum, (0 ^ 7) * 3 = 21, little-endian over 16 bytes.
+        let mut red = [0u8; 16];
+        red[0] = 21;
+        assert_eq!(bytes[44..60], red);
     }
 
     #[test]
@@ -342,6 +380,18 @@ mod tests {
             let e = Checkpoint::from_bytes(&flipped, file).unwrap_err();
             assert!(e.to_string().starts_with("c.ckpt: "), "{e}");
         }
+    }
+
+    #[test]
+    fn a_version_1_checkpoint_of_f64_sums_is_refused_by_its_version() {
+        let mut bytes = sample_checkpoint(2, 1, 4).to_bytes();
+        bytes[8..12].copy_from_slice(&1u32.to_le_bytes());
+        let e = Checkpoint::from_bytes(&bytes, Path::new("old.ckpt")).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("format version 1, this obscura reads version 2"),
+            "{e}"
+        );
     }
 
     #[test]

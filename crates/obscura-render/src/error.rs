@@ -47,6 +47,14 @@ pub enum RenderError {
         /// What is wrong.
         message: String,
     },
+    /// A slice's partial file is corrupt, truncated, or does not belong with the others.
+    #[error("{}: partial: {message}", file.display())]
+    Partial {
+        /// The partial file.
+        file: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
     /// A render setting from the command line is invalid.
     #[error("{name}: {message}")]
     Setting {

@@ -13,10 +13,11 @@
 //!   a pinhole image by its [`screen_buffers`], for comparison with the distributed ray tracing
 //!   that the renderer does.
 //!
-//! The decision to know: tiles accumulate into their own buffers, merged in tile order into a
-//! pass accumulator that is added to the film once the pass is complete, and a render is a
-//! fixed sequence of passes. So the image is bit-identical for any thread count and any tile
-//! completion order.
+//! The decision to know: tiles accumulate into their own buffers, merged into a pass
+//! accumulator that is added to the film once the pass is complete, and the film's sums are
+//! exact fixed-point integers. So the image is bit-identical for any thread count and any tile
+//! completion order, and a render split into slices of passes or tiles ([`Slice`], written as
+//! [`Partial`] files) merges ([`merge_partials`]) to exactly the one-process image.
 //!
 //! Not for: camera models, BVHs or BSDFs themselves (their crates), nor the command line (the
 //! `camera-obscura` package's `obscura` binary).
@@ -55,6 +56,7 @@ mod error;
 mod film;
 mod locate;
 mod output;
+mod partial;
 mod postprocess;
 mod render;
 mod scene;
@@ -65,9 +67,12 @@ pub use build::{
 };
 pub use checkpoint::{CHECKPOINT_MAGIC, CHECKPOINT_VERSION, Checkpoint, scene_fingerprint};
 pub use error::RenderError;
-pub use film::{Film, Filter, Image, PixelRect, PixelSums, TileBuffer};
+pub use film::{FIXED_FRACTION_BITS, Film, Filter, Image, PixelRect, PixelSums, TileBuffer};
 pub use output::{
     ImageInfo, OutputFormat, decode_exr, read_exr, srgb_8bit, temporary_beside, write_image,
+};
+pub use partial::{
+    PARTIAL_MAGIC, PARTIAL_VERSION, PartSet, Partial, Slice, SliceBy, merge_partials,
 };
 pub use postprocess::{
     DepthOfField, ScreenBuffers, circle_of_confusion, circle_of_confusion_orthographic,

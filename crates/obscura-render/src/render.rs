@@ -6,10 +6,11 @@
 //! is free merges the buffers in job order into a pass accumulator, which is added to the film
 //! pixel by pixel when its pass's last tile is merged. No worker waits at a pass or batch
 //! boundary: only a window of buffers (the slowest tile in flight holds up the merge of the
-//! ones after it) bounds how far rendering runs ahead of merging. The merge order depends only
-//! on the scene, never on threads or timing, so a render is bit-identical for any thread count,
-//! and a render stopped after pass `k` and resumed from there equals one that ran straight
-//! through.
+//! ones after it) bounds how far rendering runs ahead of merging. The film's sums are exact
+//! fixed-point integers, so a render is bit-identical for any thread count, a render stopped
+//! after pass `k` and resumed from there equals one that ran straight through, and a render
+//! of some passes or some tiles only (a slice, [`RenderOptions::passes`] and
+//! [`RenderOptions::tiles`]) adds to the other slices' films to exactly the whole render's.
 
 use crate::build::RenderScene;
 use crate::film::{Film, PixelRect, TileBuffer};
@@ -19,6 +20,7 @@ use obscura_camera::{Camera, CameraSample};
 use obscura_sample::SampleStream;
 use obscura_shade::PathIntegrator;
 use obscura_space::{Ray, World};
+use std::ops::Range;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
@@ -83,7 +85,7 @@ impl RenderOutcome {
     }
 }
 
-/// Called after each pass with (passes done, passes in all, the film so far). It may borrow
+/// Called after each pass with (passes done, the pass to stop at, the film so far). It may borrow
 /// locals of the caller (a checkpoint path, a timer): the lifetime is the options'.
 pub type PassCallback<'a> = dyn Fn(u32, u32, &Film) + Sync + 'a;
 
@@ -100,6 +102,14 @@ pub struct RenderOptions<'a> {
     pub on_tile: Option<&'a (dyn Fn(u64, u64) + Sync)>,
     /// Continue from this film, which holds this many passes.
     pub resume: Option<(Film, u32)>,
+    /// Take only these passes (sample indices) [default: all]; with `resume`, start at the
+    /// resumed pass count instead of the range's start. An end past the scene's samples per
+    /// pixel stops there.
+    pub passes: Option<Range<u32>>,
+    /// Render only these tiles, as indices into [`tiles`] of the scene's pixel bounds
+    /// [default: all]. Their samples still reach the pixels around them that the filter
+    /// covers, so films of disjoint tile ranges add up to the whole film.
+    pub tiles: Option<Range<usize>>,
 }
 
 /// The tiles covering `bounds`, row by row.
@@ -134,15 +144,23 @@ pub fn render(
     let pool = builder.build()?;
     let start = Instant::now();
     let spp = scene.sampler.samples_per_pixel();
+    let passes = options.passes.unwrap_or(0..spp);
+    let end_pass = passes.end.min(spp);
     let (film, first_pass) = options
         .resume
-        .unwrap_or_else(|| (Film::new(scene.pixel_bounds), 0));
-    let tiles = tiles(scene.pixel_bounds);
+        .unwrap_or_else(|| (Film::new(scene.pixel_bounds), passes.start));
+    let first_pass = first_pass.min(end_pass);
+    let mut tiles = tiles(scene.pixel_bounds);
+    if let Some(r) = options.tiles {
+        let end = r.end.min(tiles.len());
+        tiles.truncate(end);
+        tiles.drain(..r.start.min(end));
+    }
     // Job j is tile j % tile_count of pass first_pass + j / tile_count: workers take jobs in
     // this order from one counter, and the rendered buffers are merged in the same order
     // through a window of slots, so the film never depends on which worker rendered what.
     let tile_count = tiles.len() as u64;
-    let jobs = tile_count * u64::from(spp.saturating_sub(first_pass));
+    let jobs = tile_count * u64::from(end_pass - first_pass);
     let tiles_done = AtomicU64::new(0);
     let samples = AtomicU64::new(0);
     let dropped = AtomicU64::new(0);
@@ -182,11 +200,10 @@ pub fn render(
                     return;
                 }
                 let pass = first_pass + (m.cursor / tile_count) as u32;
-                m.film.add(&m.pass_film);
-                m.pass_film.clear();
+                m.film.absorb(&mut m.pass_film);
                 m.passes_done = pass;
                 if let Some(f) = on_pass {
-                    f(pass, spp, &m.film);
+                    f(pass, end_pass, &m.film);
                 }
             }
         }
@@ -248,7 +265,7 @@ pub fn render(
     let mut m = merger.into_inner().unwrap_or_else(|e| e.into_inner());
     merge_ready(&mut m);
     let (film, passes_done) = if tiles.is_empty() {
-        (m.film, spp)
+        (m.film, end_pass)
     } else {
         (m.film, m.passes_done)
     };

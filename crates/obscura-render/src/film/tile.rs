@@ -129,8 +129,8 @@ fn floor(v: Vec2) -> Vec2 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::film::Film;
     use crate::film::tests::film_rect;
+    use crate::film::{Film, to_fixed};
     use crate::scene::FilterSettings;
 
     #[test]
@@ -141,14 +141,15 @@ mod tests {
         tile.add_sample(Vec2::new(2.0, 1.5), Vec3::ONE, true);
         let mut film = Film::new(film_rect(4, 4));
         film.merge(&tile);
-        let touched: Vec<(usize, f64)> = film
+        let touched: Vec<(usize, i128)> = film
             .sums()
             .iter()
             .enumerate()
-            .filter(|(_, s)| s.weight > 0.0)
+            .filter(|(_, s)| s.weight > 0)
             .map(|(i, s)| (i, s.weight))
             .collect();
-        assert_eq!(touched, vec![(4 + 2, 1.0)]);
+        // Weight 1 in fixed point: 2^64.
+        assert_eq!(touched, vec![(4 + 2, 1i128 << 64)]);
     }
 
     #[test]
@@ -169,9 +170,9 @@ mod tests {
         let mut film = Film::new(film_r);
         film.merge(&tile);
         // Pixel (3, 3), centre (3.5, 3.5), is 0.6 away on each axis: inside the radius.
-        assert!(film.sums()[3 * 8 + 3].weight > 0.0);
+        assert!(film.sums()[3 * 8 + 3].weight > 0);
         // Pixel (2, 2), centre (2.5, 2.5), is 1.6 away: outside.
-        assert_eq!(film.sums()[2 * 8 + 2].weight, 0.0);
+        assert_eq!(film.sums()[2 * 8 + 2].weight, 0);
     }
 
     #[test]
@@ -215,8 +216,8 @@ mod tests {
                     let want = filter.eval_1d(p.x - (x as f32 + 0.5))
                         * filter.eval_1d(p.y - (y as f32 + 0.5));
                     let s = film.sums()[(y * 24 + x) as usize];
-                    assert_eq!(s.weight, f64::from(want), "{settings:?} at ({x}, {y})");
-                    assert_eq!(s.radiance[0], f64::from(want * 2.0));
+                    assert_eq!(s.weight, to_fixed(want), "{settings:?} at ({x}, {y})");
+                    assert_eq!(s.radiance[0], to_fixed(want * 2.0));
                     touched += usize::from(want != 0.0);
                 }
             }
