@@ -276,7 +276,12 @@ async function hover(e) {
       const v3 = (a) => a.map((n) => n.toFixed(3).padStart(8)).join(' ');
       let text = `raster ${v3(c.raster)}\n`;
       if (c.projective) {
-        text += `NDC    ${v3(c.projective.ndc)}\nscreen ${v3(c.projective.screen)}\ncamera ${v3(c.projective.camera)}\n`;
+        const p = c.projective;
+        text += `NDC    ${v3(p.ndc)}\nscreen ${v3(p.screen)}\ncamera ${v3(p.camera)}  (on the near plane)\n`;
+        // A perspective camera's near plane is tiny: the same direction on the plane z = 1.
+        if (currentType() === 'perspective' && p.camera[2] > 0) {
+          text += `       ${v3(p.camera.map((v) => v / p.camera[2]))}  (on z = 1)\n`;
+        }
       }
       if (c.ray) text += `ray d  ${v3(c.ray.direction)}`;
       else text += 'no ray leaves this pixel';
@@ -295,6 +300,7 @@ function scheduleCompare() {
 async function refreshCompare() {
   const mode = $('compare-mode').value;
   $('compare').hidden = !mode;
+  $('stage').classList.toggle('comparing', !!mode);
   if (!mode || state.session === null) return;
   const res = await fetch(`/api/postprocess.png?session=${state.session}&effect=${mode}`);
   if (!res.ok) {
