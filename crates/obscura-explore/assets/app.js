@@ -297,19 +297,27 @@ function scheduleCompare() {
   clearTimeout(compareTimer);
   compareTimer = setTimeout(refreshCompare, 400);
 }
+let compareAsked = 0;
 async function refreshCompare() {
   const mode = $('compare-mode').value;
   $('compare').hidden = !mode;
   $('stage').classList.toggle('comparing', !!mode);
   if (!mode || state.session === null) return;
+  // Answers may come back out of order: only the latest request's is shown.
+  const asked = ++compareAsked;
+  $('post-caption').textContent = 'post-process: rendering…';
   const res = await fetch(`/api/postprocess.png?session=${state.session}&effect=${mode}`);
+  if (asked !== compareAsked) return;
   if (!res.ok) {
     const body = await res.json();
     $('post-caption').textContent = body.error;
     $('post').removeAttribute('src');
     return;
   }
-  $('post').src = URL.createObjectURL(await res.blob());
+  const blob = await res.blob();
+  if (asked !== compareAsked) return;
+  if ($('post').src) URL.revokeObjectURL($('post').src);
+  $('post').src = URL.createObjectURL(blob);
   $('post-caption').textContent = mode === 'dof'
     ? 'post-process depth of field (Potmesil and Chakravarty) of a pinhole image'
     : 'post-process motion blur (Potmesil and Chakravarty) of an instant';

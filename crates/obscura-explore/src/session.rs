@@ -44,6 +44,9 @@ pub struct Status {
     pub passes_done: u32,
     /// Passes the latest frame's view asks for.
     pub passes: u32,
+    /// Passes in the first frame sent of the latest frame's view (1 when its render started
+    /// from scratch).
+    pub first_pass: u32,
     /// Renders started.
     pub renders_started: u64,
     /// Renders stopped by a change before their last pass.
@@ -219,6 +222,9 @@ impl Shared {
             *lock(&self.latest) = Some((image, generation, done));
             {
                 let mut s = lock(&self.status);
+                if s.frame_generation != generation || s.passes_done == 0 {
+                    s.first_pass = done;
+                }
                 s.frame_generation = generation;
                 s.passes_done = done;
                 s.passes = all;

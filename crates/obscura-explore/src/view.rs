@@ -139,7 +139,18 @@ impl View {
             key: "camera".into(),
             message: e.to_string(),
         })?;
-        let description = parse_description(&self.path, &text)?;
+        // The line numbers would be those of the regenerated text, not of the user's file.
+        let description = parse_description(&self.path, &text).map_err(|e| match e {
+            RenderError::Scene {
+                file, key, message, ..
+            } => RenderError::Scene {
+                file,
+                line: None,
+                key,
+                message,
+            },
+            other => other,
+        })?;
         let [w, h] = description.film.resolution;
         check_resolution(w, h)?;
         if description.sampler.spp > MAX_SPP {
@@ -252,6 +263,14 @@ radius = 1.0
             .apply(&change(r#"{"camera": {"fov": 400.0}}"#))
             .unwrap_err();
         assert_eq!(e.key().as_deref(), Some("camera.fov"), "{e}");
+        // No line number: it would count lines of the regenerated text, not of the file.
+        assert!(
+            matches!(
+                e,
+                ExploreError::Render(RenderError::Scene { line: None, .. })
+            ),
+            "{e:?}"
+        );
         let e = v
             .apply(&change(r#"{"camera": {"no_such_key": 1}}"#))
             .unwrap_err();
