@@ -404,3 +404,36 @@ async fn the_websocket_streams_frames_and_takes_changes() {
     assert_eq!(x.session_count(), 0);
     server.abort();
 }
+
+#[tokio::test]
+async fn pages_past_the_limit_are_refused_and_the_server_keeps_answering() {
+    let x = explorer(4);
+    let mut ids = Vec::new();
+    for _ in 0..obscura_explore::MAX_SESSIONS {
+        let (status, s) = call_json(&x, "POST", "/api/session", "").await;
+        assert_eq!(status, StatusCode::CREATED, "{s}");
+        ids.push(s["session"].as_u64().unwrap());
+    }
+    let (status, v) = call_json(&x, "POST", "/api/session", "").await;
+    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{v}");
+    assert_eq!(v["key"], json!("session"));
+    // With every session rendering, the API still answers, and each session's view is its own.
+    let (status, _) = call_json(&x, "GET", "/api/scene", "").await;
+    assert_eq!(status, StatusCode::OK);
+    let (status, _) = call_json(
+        &x,
+        "POST",
+        &format!("/api/view?session={}", ids[0]),
+        r#"{"camera": {"fov": 30}}"#,
+    )
+    .await;
+    assert_eq!(status, StatusCode::OK);
+    let (_, other) = call_json(&x, "GET", &format!("/api/scene?session={}", ids[1]), "").await;
+    assert_eq!(other["camera"]["fov"], json!(40.0));
+    for id in ids {
+        let (status, _) = call(&x, "DELETE", &format!("/api/session?session={id}"), "").await;
+        assert_eq!(status, StatusCode::NO_CONTENT);
+    }
+    let (status, _) = call_json(&x, "POST", "/api/session", "").await;
+    assert_eq!(status, StatusCode::CREATED);
+}
