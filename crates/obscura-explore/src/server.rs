@@ -17,7 +17,7 @@ use obscura_render::{
 use serde::Deserialize;
 use serde_json::{Value as Json, json};
 use std::collections::HashMap;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
 /// The most pages (sessions) served at once; each has its own scene and render thread.
@@ -37,6 +37,9 @@ pub struct Explorer {
     base: View,
     sessions: Mutex<HashMap<u64, Arc<Session>>>,
     next_id: AtomicU64,
+    /// Sessions whose scenes are being built, counted against the limit (changed under the
+    /// sessions' lock, so that concurrent requests cannot pass it together).
+    starting: AtomicUsize,
     threads: Option<usize>,
 }
 
@@ -48,6 +51,7 @@ impl Explorer {
             base,
             sessions: Mutex::new(HashMap::new()),
             next_id: AtomicU64::new(1),
+            starting: AtomicUsize::new(0),
             threads,
         })
     }
@@ -58,19 +62,27 @@ impl Explorer {
 
     /// Starts a session (builds its scene off the async runtime).
     async fn open(self: &Arc<Self>) -> Result<(u64, Arc<Session>), ExploreError> {
-        if self.sessions().len() >= MAX_SESSIONS {
-            return Err(ExploreError::Refused {
-                key: "session".into(),
-                message: format!("{MAX_SESSIONS} pages are open already; close one"),
-            });
+        {
+            let sessions = self.sessions();
+            if sessions.len() + self.starting.load(Ordering::SeqCst) >= MAX_SESSIONS {
+                return Err(ExploreError::Refused {
+                    key: "session".into(),
+                    message: format!("{MAX_SESSIONS} pages are open already; close one"),
+                });
+            }
+            self.starting.fetch_add(1, Ordering::SeqCst);
         }
+        // Released however this ends, also when the request is dropped mid-build.
+        let _slot = Slot(&self.starting);
         let (base, threads) = (self.base.clone(), self.threads);
-        let session = tokio::task::spawn_blocking(move || Session::start(base, threads))
+        let started = tokio::task::spawn_blocking(move || Session::start(base, threads))
             .await
-            .map_err(|e| ExploreError::Internal(e.to_string()))??;
+            .map_err(|e| ExploreError::Internal(e.to_string()))
+            .and_then(|r| r);
+        let mut sessions = self.sessions();
+        let session = Arc::new(started?);
         let id = self.next_id.fetch_add(1, Ordering::SeqCst);
-        let session = Arc::new(session);
-        self.sessions().insert(id, session.clone());
+        sessions.insert(id, session.clone());
         Ok((id, session))
     }
 
@@ -96,6 +108,15 @@ impl Explorer {
     /// Sessions open now.
     pub fn session_count(&self) -> usize {
         self.sessions().len()
+    }
+}
+
+/// A reserved place among the sessions being started; given back when dropped.
+struct Slot<'a>(&'a AtomicUsize);
+
+impl Drop for Slot<'_> {
+    fn drop(&mut self) {
+        self.0.fetch_sub(1, Ordering::SeqCst);
     }
 }
 
