@@ -51,6 +51,8 @@ enum Command {
     /// Merge the partial films of `obscura render --slice i/N` into the image a single render
     /// makes, bit for bit.
     Merge(MergeArgs),
+    /// Explore a scene's camera in the browser: a local server that renders progressively.
+    Serve(ServeArgs),
 }
 
 /// The `merge` subcommand's arguments.
@@ -72,6 +74,23 @@ struct MergeArgs {
     slices: Option<u32>,
 }
 
+/// The `serve` subcommand's arguments.
+#[derive(clap::Args)]
+struct ServeArgs {
+    /// The scene file (TOML).
+    #[arg(value_name = "SCENE")]
+    scene: PathBuf,
+    /// Port to listen on; 0 picks a free one (the URL printed says which)
+    #[arg(long, default_value_t = 8080)]
+    port: u16,
+    /// Address to listen on; anything but loopback exposes the explorer to the network
+    #[arg(long, default_value = "127.0.0.1")]
+    host: std::net::IpAddr,
+    /// Render threads per page [default: one per core]
+    #[arg(long)]
+    threads: Option<usize>,
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
@@ -81,6 +100,25 @@ fn main() -> ExitCode {
             run_convert(&scene, output).map(|()| ExitCode::SUCCESS)
         }
         Command::Merge(args) => run_merge(args),
+        Command::Serve(args) => {
+            if args.threads == Some(0) {
+                eprintln!("error: --threads: must be >= 1, got 0");
+                return ExitCode::from(2);
+            }
+            let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+            let threads = args.threads.map(|n| n.min(MAX_THREADS_PER_CORE * cores));
+            // The explorer's errors are its own; print them here with the same exit status.
+            if let Err(e) = obscura_explore::run(obscura_explore::ServeOptions {
+                scene: args.scene,
+                host: args.host,
+                port: args.port,
+                threads,
+            }) {
+                eprintln!("error: {e}");
+                return ExitCode::from(2);
+            }
+            Ok(ExitCode::SUCCESS)
+        }
     };
     match result {
         Ok(code) => code,

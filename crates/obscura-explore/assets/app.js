@@ -1,0 +1,335 @@
+// The Obscura camera explorer page: controls generated from CONTROLS, frames over a WebSocket,
+// drag to orbit, click to focus, coordinates overlay, post-process comparison, saves.
+'use strict';
+
+const PROJECTIVE = ['perspective', 'orthographic'];
+const OPENCV = ['opencv', 'opencv_fisheye'];
+
+// One entry per [camera] key (docs/scene-format.md). `models` lists the camera types the key
+// applies to (absent: all). A new camera model is one entry in /api/scene's types plus entries
+// here for its own keys.
+const CONTROLS = [
+  { key: 'type', kind: 'select', options: [] /* from /api/scene */ },
+  { key: 'fov', kind: 'range', min: 1, max: 179, step: 0.5, def: 90,
+    models: ['perspective', 'fisheye', 'cylindrical'] },
+  { key: 'fov_axis', kind: 'select', options: ['smaller', 'larger', 'x', 'y', 'diagonal'],
+    def: 'smaller', models: ['perspective'] },
+  { key: 'eye', kind: 'vec', n: 3, def: [0, 0, 0] },
+  { key: 'target', kind: 'vec', n: 3, def: [0, 0, -1] },
+  { key: 'up', kind: 'vec', n: 3, def: [0, 1, 0] },
+  { key: 'lens_radius', kind: 'range', min: 0, max: 1, step: 0.005, def: 0, models: PROJECTIVE },
+  { key: 'focal_distance', kind: 'range', min: 0.05, max: 50, step: 0.01, def: 1,
+    models: PROJECTIVE },
+  { key: 'aperture_blades', kind: 'int', min: 0, max: 64, def: 0, models: PROJECTIVE },
+  { key: 'aperture_rotation', kind: 'range', min: 0, max: 360, step: 1, def: 0,
+    models: PROJECTIVE },
+  { key: 'shutter', kind: 'vec', n: 2, def: [0, 1] },
+  { key: 'eye_end', kind: 'vec', n: 3, optional: true },
+  { key: 'target_end', kind: 'vec', n: 3, optional: true },
+  { key: 'near', kind: 'number', def: 0.001 },
+  { key: 'far', kind: 'number', def: 1e30 },
+  { key: 'lens_shift', kind: 'vec', n: 2, def: [0, 0],
+    models: ['perspective', 'orthographic', 'fisheye'] },
+  { key: 'projection', kind: 'select',
+    options: ['equidistant', 'equisolid', 'stereographic', 'orthographic'], def: 'equidistant',
+    models: ['fisheye'] },
+  { key: 'face', kind: 'select', options: ['+x', '-x', '+y', '-y', '+z', '-z'], def: '+z',
+    models: ['cube_face'] },
+  { key: 'fx', kind: 'number', models: OPENCV },
+  { key: 'fy', kind: 'number', models: OPENCV },
+  { key: 'cx', kind: 'number', models: OPENCV },
+  { key: 'cy', kind: 'number', models: OPENCV },
+  { key: 'distortion', kind: 'list', models: OPENCV },
+];
+
+const $ = (id) => document.getElementById(id);
+const canvas = $('view');
+const ctx = canvas.getContext('2d', { willReadFrequently: true });
+
+// What the page knows; window.explorer lets tests read it.
+const state = {
+  session: null, camera: {}, resolution: [1, 1], spp: 1, generation: 0,
+  frame: { generation: -1, pass: 0, passes: 0 }, effective: {}, lastError: null,
+};
+window.explorer = state;
+
+let socket = null;
+
+function applies(control, type) {
+  return !control.models || control.models.includes(type);
+}
+
+function currentType() {
+  return state.camera.type || 'perspective';
+}
+
+function valueOf(key) {
+  if (key in state.camera) return state.camera[key];
+  if (key in state.effective) return state.effective[key];
+  const c = CONTROLS.find((c) => c.key === key);
+  return c ? c.def : undefined;
+}
+
+function send(change) {
+  if (socket && socket.readyState === WebSocket.OPEN) socket.send(JSON.stringify(change));
+}
+
+function setCamera(key, value) {
+  const change = { camera: { [key]: value } };
+  if (key === 'type') {
+    // Drop the keys the new model does not take.
+    for (const c of CONTROLS) {
+      if (c.key in state.camera && !applies(c, value)) change.camera[c.key] = null;
+    }
+  }
+  send(change);
+}
+
+function buildControls(types) {
+  const form = $('controls');
+  form.textContent = '';
+  CONTROLS[0].options = types;
+  const legend = document.createElement('legend');
+  const fs = document.createElement('fieldset');
+  legend.textContent = 'Camera';
+  fs.append(legend);
+  for (const c of CONTROLS) {
+    const label = document.createElement('label');
+    label.dataset.key = c.key;
+    const name = document.createElement('span');
+    name.className = 'key';
+    name.textContent = c.key;
+    label.append(name);
+    if (c.kind === 'select') {
+      const sel = document.createElement('select');
+      sel.id = 'c-' + c.key;
+      for (const o of c.options) sel.append(new Option(o, o));
+      sel.addEventListener('change', () => setCamera(c.key, sel.value));
+      label.append(sel);
+    } else if (c.kind === 'range') {
+      const input = document.createElement('input');
+      Object.assign(input, { type: 'range', min: c.min, max: c.max, step: c.step, id: 'c-' + c.key });
+      const out = document.createElement('output');
+      input.addEventListener('input', () => {
+        out.textContent = input.value;
+        setCamera(c.key, Number(input.value));
+      });
+      label.append(input, out);
+    } else if (c.kind === 'int' || c.kind === 'number') {
+      const input = document.createElement('input');
+      Object.assign(input, { type: 'number', id: 'c-' + c.key, step: c.kind === 'int' ? 1 : 'any' });
+      input.addEventListener('change', () => setCamera(c.key, Number(input.value)));
+      label.append(input);
+    } else if (c.kind === 'vec' || c.kind === 'list') {
+      const input = document.createElement('input');
+      Object.assign(input, { type: 'text', id: 'c-' + c.key, size: 16,
+        placeholder: c.optional ? '(none)' : '' });
+      input.addEventListener('change', () => {
+        const text = input.value.trim();
+        if (text === '' && (c.optional || c.kind === 'list')) return setCamera(c.key, null);
+        const v = text.split(/[\s,]+/).map(Number);
+        if (c.kind === 'vec' && v.length !== c.n) return showError(`${c.key}: ${c.n} numbers, please`);
+        setCamera(c.key, v);
+      });
+      label.append(input);
+    }
+    fs.append(label);
+  }
+  form.append(fs);
+}
+
+function fmt(v) {
+  return typeof v === 'number' ? String(Math.round(v * 1e4) / 1e4) : String(v);
+}
+
+function showControls() {
+  const type = currentType();
+  for (const c of CONTROLS) {
+    const label = document.querySelector(`label[data-key="${c.key}"]`);
+    if (!label) continue;
+    label.classList.toggle('hidden', !applies(c, type));
+    const input = $('c-' + c.key);
+    if (document.activeElement === input && c.kind !== 'range') continue;
+    const v = valueOf(c.key);
+    if (c.kind === 'vec' || c.kind === 'list') input.value = v === undefined ? '' : v.map(fmt).join(', ');
+    else if (v !== undefined) input.value = v;
+    if (c.kind === 'range') label.querySelector('output').textContent = fmt(Number(input.value));
+  }
+  $('res-w').value = state.resolution[0];
+  $('res-h').value = state.resolution[1];
+  $('spp').value = state.spp;
+  const q = `?session=${state.session}`;
+  $('save-toml').href = '/api/scene.toml' + q;
+  $('save-png').href = '/api/image.png' + q;
+  $('save-exr').href = '/api/image.exr' + q;
+}
+
+function showError(message) {
+  state.lastError = message;
+  $('error').textContent = message || '';
+}
+
+function takeView(msg) {
+  state.camera = msg.camera || {};
+  state.resolution = msg.resolution;
+  state.spp = msg.spp;
+  state.effective = msg.effective || {};
+  if (msg.generation !== undefined) state.generation = msg.generation;
+  showError(null);
+  showControls();
+  scheduleCompare();
+}
+
+async function onFrame(buffer) {
+  const head = new DataView(buffer, 0, 12);
+  const generation = head.getUint32(0, true);
+  const pass = head.getUint32(4, true);
+  const passes = head.getUint32(8, true);
+  const bitmap = await createImageBitmap(new Blob([buffer.slice(12)], { type: 'image/png' }));
+  if (canvas.width !== bitmap.width || canvas.height !== bitmap.height) {
+    canvas.width = bitmap.width;
+    canvas.height = bitmap.height;
+  }
+  ctx.drawImage(bitmap, 0, 0);
+  state.frame = { generation, pass, passes };
+  canvas.dataset.generation = generation;
+  canvas.dataset.pass = pass;
+  $('progress').textContent = `pass ${pass} / ${passes}`;
+}
+
+function connect() {
+  const proto = location.protocol === 'https:' ? 'wss:' : 'ws:';
+  socket = new WebSocket(`${proto}//${location.host}/api/ws`);
+  socket.binaryType = 'arraybuffer';
+  socket.onmessage = (e) => {
+    if (typeof e.data !== 'string') return onFrame(e.data);
+    const msg = JSON.parse(e.data);
+    if (msg.type === 'hello') {
+      state.session = msg.session;
+      takeView(msg);
+    } else if (msg.type === 'view') {
+      takeView(msg);
+    } else if (msg.type === 'error') {
+      showError(msg.error);
+      showControls();
+    }
+  };
+  socket.onclose = () => { $('progress').textContent = 'disconnected (reload to reconnect)'; };
+}
+
+// Raster position of a pointer event.
+function rasterOf(e) {
+  const r = canvas.getBoundingClientRect();
+  return [(e.clientX - r.left) / r.width * canvas.width, (e.clientY - r.top) / r.height * canvas.height];
+}
+
+// Drag orbits the eye about the target (turntable about world +y); a click without a drag
+// focuses on the surface under the pointer.
+let drag = null;
+canvas.addEventListener('pointerdown', (e) => {
+  drag = { x: e.clientX, y: e.clientY, moved: false, eye: valueOf('eye'), target: valueOf('target') };
+  canvas.setPointerCapture(e.pointerId);
+});
+canvas.addEventListener('pointermove', (e) => {
+  hover(e);
+  if (!drag) return;
+  const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
+  if (!drag.moved && Math.hypot(dx, dy) < 4) return;
+  drag.moved = true;
+  const [ex, ey, ez] = drag.eye, [tx, ty, tz] = drag.target;
+  const v = [ex - tx, ey - ty, ez - tz];
+  const r = Math.hypot(...v);
+  if (r === 0) return;
+  let az = Math.atan2(v[0], v[2]) - dx * 0.01;
+  let el = Math.asin(Math.max(-1, Math.min(1, v[1] / r))) + dy * 0.01;
+  el = Math.max(-1.5, Math.min(1.5, el));
+  const eye = [tx + r * Math.cos(el) * Math.sin(az), ty + r * Math.sin(el), tz + r * Math.cos(el) * Math.cos(az)];
+  setCamera('eye', eye);
+});
+canvas.addEventListener('pointerup', async (e) => {
+  const wasDrag = drag && drag.moved;
+  drag = null;
+  if (wasDrag) return;
+  const [x, y] = rasterOf(e);
+  const res = await fetch(`/api/focus?session=${state.session}`, {
+    method: 'POST', headers: { 'content-type': 'application/json' }, body: JSON.stringify({ x, y }),
+  });
+  const body = await res.json();
+  if (!res.ok) return showError(body.error);
+  state.focus = { x, y, depth: body.depth };
+  takeView(body);
+});
+canvas.addEventListener('pointerleave', () => { $('overlay').textContent = ''; });
+
+// The coordinates overlay, asked of the camera crate (one request at a time).
+let hoverBusy = false, hoverNext = null;
+async function hover(e) {
+  hoverNext = rasterOf(e);
+  if (hoverBusy) return;
+  hoverBusy = true;
+  while (hoverNext) {
+    const [x, y] = hoverNext;
+    hoverNext = null;
+    try {
+      const res = await fetch(`/api/coords?session=${state.session}&x=${x}&y=${y}`);
+      const c = await res.json();
+      const v3 = (a) => a.map((n) => n.toFixed(3).padStart(8)).join(' ');
+      let text = `raster ${v3(c.raster)}\n`;
+      if (c.projective) {
+        const p = c.projective;
+        text += `NDC    ${v3(p.ndc)}\nscreen ${v3(p.screen)}\ncamera ${v3(p.camera)}  (on the near plane)\n`;
+        // A perspective camera's near plane is tiny: the same direction on the plane z = 1.
+        if (currentType() === 'perspective' && p.camera[2] > 0) {
+          text += `       ${v3(p.camera.map((v) => v / p.camera[2]))}  (on z = 1)\n`;
+        }
+      }
+      if (c.ray) text += `ray d  ${v3(c.ray.direction)}`;
+      else text += 'no ray leaves this pixel';
+      $('overlay').textContent = text;
+    } catch (err) { /* the next move asks again */ }
+  }
+  hoverBusy = false;
+}
+
+// The post-process comparison, refreshed a moment after the view settles.
+let compareTimer = null;
+function scheduleCompare() {
+  clearTimeout(compareTimer);
+  compareTimer = setTimeout(refreshCompare, 400);
+}
+let compareAsked = 0;
+async function refreshCompare() {
+  const mode = $('compare-mode').value;
+  $('compare').hidden = !mode;
+  $('stage').classList.toggle('comparing', !!mode);
+  if (!mode || state.session === null) return;
+  // Answers may come back out of order: only the latest request's is shown.
+  const asked = ++compareAsked;
+  $('post-caption').textContent = 'post-process: rendering…';
+  const res = await fetch(`/api/postprocess.png?session=${state.session}&effect=${mode}`);
+  if (asked !== compareAsked) return;
+  if (!res.ok) {
+    const body = await res.json();
+    $('post-caption').textContent = body.error;
+    $('post').removeAttribute('src');
+    return;
+  }
+  const blob = await res.blob();
+  if (asked !== compareAsked) return;
+  if ($('post').src) URL.revokeObjectURL($('post').src);
+  $('post').src = URL.createObjectURL(blob);
+  $('post-caption').textContent = mode === 'dof'
+    ? 'post-process depth of field (Potmesil and Chakravarty) of a pinhole image'
+    : 'post-process motion blur (Potmesil and Chakravarty) of an instant';
+}
+$('compare-mode').addEventListener('change', refreshCompare);
+
+$('res-w').addEventListener('change', () => send({ resolution: [Number($('res-w').value), Number($('res-h').value)] }));
+$('res-h').addEventListener('change', () => send({ resolution: [Number($('res-w').value), Number($('res-h').value)] }));
+$('spp').addEventListener('change', () => send({ spp: Number($('spp').value) }));
+
+fetch('/api/scene').then((r) => r.json()).then((scene) => {
+  $('file').textContent = scene.file;
+  buildControls(scene.types);
+  connect();
+});

@@ -1,0 +1,547 @@
+//! The HTTP and WebSocket API (docs/explorer.md lists it) and the embedded page.
+
+use crate::error::ExploreError;
+use crate::session::{Session, coordinates, depth_at, png_bytes};
+use crate::view::{MAX_EDGE, MAX_PIXELS, MAX_SPP, View, ViewChange};
+use axum::Router;
+use axum::body::Bytes;
+use axum::extract::ws::{Message, WebSocket, WebSocketUpgrade};
+use axum::extract::{Path as UrlPath, Query, State};
+use axum::http::{StatusCode, header};
+use axum::response::{IntoResponse, Response};
+use axum::routing::{get, post};
+use obscura_render::{
+    CameraKind, DepthOfField, ImageInfo, RenderOptions, RenderScene, depth_of_field, motion_blur,
+    render, screen_buffers, write_image,
+};
+use serde::Deserialize;
+use serde_json::{Value as Json, json};
+use std::collections::HashMap;
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
+
+/// The most pages (sessions) served at once; each has its own scene and render thread.
+pub const MAX_SESSIONS: usize = 16;
+
+/// Samples per pixel of the pinhole image that the post-process comparison blurs.
+const POSTPROCESS_SPP: u32 = 16;
+
+/// The camera models the page offers, as the scene format names them: every model the scene
+/// layer knows, so a new model appears without a change here.
+pub fn camera_types() -> Vec<&'static str> {
+    CameraKind::ALL.iter().map(|k| k.name()).collect()
+}
+
+/// The server's state: the scene file's view and the pages' sessions.
+pub struct Explorer {
+    base: View,
+    sessions: Mutex<HashMap<u64, Arc<Session>>>,
+    next_id: AtomicU64,
+    /// Sessions whose scenes are being built, counted against the limit (changed under the
+    /// sessions' lock, so that concurrent requests cannot pass it together).
+    starting: AtomicUsize,
+    threads: Option<usize>,
+}
+
+impl Explorer {
+    /// An explorer of the scene `base`, rendering with `threads` workers per page (None: one
+    /// per core).
+    pub fn new(base: View, threads: Option<usize>) -> Arc<Explorer> {
+        Arc::new(Explorer {
+            base,
+            sessions: Mutex::new(HashMap::new()),
+            next_id: AtomicU64::new(1),
+            starting: AtomicUsize::new(0),
+            threads,
+        })
+    }
+
+    fn sessions(&self) -> std::sync::MutexGuard<'_, HashMap<u64, Arc<Session>>> {
+        self.sessions.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Starts a session (builds its scene off the async runtime).
+    async fn open(self: &Arc<Self>) -> Result<(u64, Arc<Session>), ExploreError> {
+        {
+            let sessions = self.sessions();
+            if sessions.len() + self.starting.load(Ordering::SeqCst) >= MAX_SESSIONS {
+                return Err(ExploreError::Refused {
+                    key: "session".into(),
+                    message: format!("{MAX_SESSIONS} pages are open already; close one"),
+                });
+            }
+            self.starting.fetch_add(1, Ordering::SeqCst);
+        }
+        // Released however this ends, also when the request is dropped mid-build.
+        let _slot = Slot(&self.starting);
+        let (base, threads) = (self.base.clone(), self.threads);
+        let started = tokio::task::spawn_blocking(move || Session::start(base, threads))
+            .await
+            .map_err(|e| ExploreError::Internal(e.to_string()))
+            .and_then(|r| r);
+        let mut sessions = self.sessions();
+        let session = Arc::new(started?);
+        let id = self.next_id.fetch_add(1, Ordering::SeqCst);
+        sessions.insert(id, session.clone());
+        Ok((id, session))
+    }
+
+    fn session(&self, id: Option<u64>) -> Result<Option<Arc<Session>>, ExploreError> {
+        match id {
+            None => Ok(None),
+            Some(id) => self
+                .sessions()
+                .get(&id)
+                .cloned()
+                .map(Some)
+                .ok_or(ExploreError::NoSession(id)),
+        }
+    }
+
+    fn view_of(&self, id: Option<u64>) -> Result<View, ExploreError> {
+        Ok(match self.session(id)? {
+            Some(s) => s.view(),
+            None => self.base.clone(),
+        })
+    }
+
+    /// Sessions open now.
+    pub fn session_count(&self) -> usize {
+        self.sessions().len()
+    }
+}
+
+/// A reserved place among the sessions being started; given back when dropped.
+struct Slot<'a>(&'a AtomicUsize);
+
+impl Drop for Slot<'_> {
+    fn drop(&mut self) {
+        self.0.fetch_sub(1, Ordering::SeqCst);
+    }
+}
+
+/// The router of the page, its assets and the API.
+pub fn router(explorer: Arc<Explorer>) -> Router {
+    Router::new()
+        .route("/", get(index))
+        .route("/assets/{file}", get(asset))
+        .route("/api/scene", get(scene_json))
+        .route("/api/session", post(open_session).delete(close_session))
+        .route("/api/view", post(change_view))
+        .route("/api/status", get(status))
+        .route("/api/focus", post(focus))
+        .route("/api/coords", get(coords))
+        .route("/api/scene.toml", get(scene_toml))
+        .route("/api/image.png", get(image_png))
+        .route("/api/image.exr", get(image_exr))
+        .route("/api/postprocess.png", get(postprocess))
+        .route("/api/ws", get(websocket))
+        .with_state(explorer)
+}
+
+type Api = State<Arc<Explorer>>;
+
+/// `?session=ID`, where a request may name a page's session.
+#[derive(Deserialize)]
+struct SessionQuery {
+    session: Option<u64>,
+}
+
+async fn index() -> Response {
+    (
+        [(header::CONTENT_TYPE, "text/html; charset=utf-8")],
+        include_str!("../assets/index.html"),
+    )
+        .into_response()
+}
+
+async fn asset(UrlPath(file): UrlPath<String>) -> Response {
+    let (body, kind) = match file.as_str() {
+        "app.js" => (
+            include_str!("../assets/app.js"),
+            "text/javascript; charset=utf-8",
+        ),
+        "style.css" => (
+            include_str!("../assets/style.css"),
+            "text/css; charset=utf-8",
+        ),
+        _ => return (StatusCode::NOT_FOUND, "no such asset").into_response(),
+    };
+    ([(header::CONTENT_TYPE, kind)], body).into_response()
+}
+
+/// The view's parameters as the page shows them.
+fn view_json(view: &View) -> Json {
+    let d = view.description();
+    json!({
+        "camera": view.camera_json(),
+        "resolution": d.film.resolution,
+        "spp": d.sampler.spp,
+        "effective": {
+            "type": d.camera.kind.name(),
+            "lens_radius": d.camera.lens.radius,
+            "focal_distance": d.camera.lens.focal_distance,
+            "fov": d.camera.fov,
+            "shutter": [d.camera.shutter.open, d.camera.shutter.close],
+        },
+    })
+}
+
+async fn scene_json(
+    State(x): Api,
+    Query(q): Query<SessionQuery>,
+) -> Result<Response, ExploreError> {
+    let view = x.view_of(q.session)?;
+    let mut body = view_json(&view);
+    body["types"] = json!(camera_types());
+    body["limits"] = json!({ "max_edge": MAX_EDGE, "max_pixels": MAX_PIXELS, "max_spp": MAX_SPP });
+    body["file"] = json!(view.description().file.display().to_string());
+    Ok(axum::Json(body).into_response())
+}
+
+async fn open_session(State(x): Api) -> Result<Response, ExploreError> {
+    let (id, session) = x.open().await?;
+    let mut body = view_json(&session.view());
+    body["session"] = json!(id);
+    Ok((StatusCode::CREATED, axum::Json(body)).into_response())
+}
+
+async fn close_session(
+    State(x): Api,
+    Query(q): Query<SessionQuery>,
+) -> Result<Response, ExploreError> {
+    let id = q
+        .session
+        .ok_or_else(|| ExploreError::BadRequest("no session named".into()))?;
+    x.sessions()
+        .remove(&id)
+        .map(|_| StatusCode::NO_CONTENT.into_response())
+        .ok_or(ExploreError::NoSession(id))
+}
+
+/// Parses a JSON body, turning every malformation into a 400 with serde's message.
+fn parse_body<T: serde::de::DeserializeOwned>(body: &Bytes) -> Result<T, ExploreError> {
+    serde_json::from_slice(body).map_err(|e| ExploreError::BadRequest(e.to_string()))
+}
+
+/// Applies a change to a session's view (restarting its render), or, without a session,
+/// only validates it against the scene file's view.
+async fn change_view(
+    State(x): Api,
+    Query(q): Query<SessionQuery>,
+    body: Bytes,
+) -> Result<Response, ExploreError> {
+    let change: ViewChange = parse_body(&body)?;
+    let mut out = match x.session(q.session)? {
+        Some(s) => {
+            let (generation, view) = s.change(&change)?;
+            let mut v = view_json(&view);
+            v["generation"] = json!(generation);
+            v
+        }
+        None => view_json(&x.base.apply(&change)?),
+    };
+    out["ok"] = json!(true);
+    Ok(axum::Json(out).into_response())
+}
+
+async fn status(State(x): Api, Query(q): Query<SessionQuery>) -> Result<Response, ExploreError> {
+    let s = x
+        .session(q.session)?
+        .ok_or_else(|| ExploreError::BadRequest("no session named".into()))?;
+    Ok(axum::Json(s.status()).into_response())
+}
+
+/// A raster position, as the page sends it.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Pixel {
+    x: f32,
+    y: f32,
+}
+
+/// Runs blocking work (ray casts, scene builds, renders) off the async runtime.
+async fn blocking<T: Send + 'static>(
+    f: impl FnOnce() -> Result<T, ExploreError> + Send + 'static,
+) -> Result<T, ExploreError> {
+    tokio::task::spawn_blocking(f)
+        .await
+        .map_err(|e| ExploreError::Internal(e.to_string()))?
+}
+
+/// Autofocus: the depth under the pixel becomes the session's focal distance.
+async fn focus(
+    State(x): Api,
+    Query(q): Query<SessionQuery>,
+    body: Bytes,
+) -> Result<Response, ExploreError> {
+    let Pixel { x: px, y: py } = parse_body(&body)?;
+    match x.session(q.session)? {
+        Some(s) => {
+            let depth = {
+                let s = s.clone();
+                blocking(move || s.with_scene(|scene| depth_at(scene, px, py))).await?
+            };
+            let mut change = ViewChange::default();
+            change.camera.insert("focal_distance".into(), json!(depth));
+            let (generation, view) = s.change(&change)?;
+            let mut out = view_json(&view);
+            out["depth"] = json!(depth);
+            out["generation"] = json!(generation);
+            Ok(axum::Json(out).into_response())
+        }
+        None => {
+            let base = x.base.clone();
+            let depth = blocking(move || {
+                let scene = RenderScene::build(base.description().clone())?;
+                depth_at(&scene, px, py)
+            })
+            .await?;
+            Ok(axum::Json(json!({ "depth": depth })).into_response())
+        }
+    }
+}
+
+#[derive(Deserialize)]
+struct CoordsQuery {
+    session: Option<u64>,
+    x: f32,
+    y: f32,
+}
+
+async fn coords(State(x): Api, Query(q): Query<CoordsQuery>) -> Result<Response, ExploreError> {
+    if !(q.x.is_finite() && q.y.is_finite()) {
+        return Err(ExploreError::BadRequest("x and y must be finite".into()));
+    }
+    let view = x.view_of(q.session)?;
+    let camera = obscura_render::camera_of(view.description())?;
+    Ok(axum::Json(coordinates(&camera, q.x, q.y)).into_response())
+}
+
+async fn scene_toml(
+    State(x): Api,
+    Query(q): Query<SessionQuery>,
+) -> Result<Response, ExploreError> {
+    let view = x.view_of(q.session)?;
+    Ok((
+        [
+            (header::CONTENT_TYPE, "application/toml; charset=utf-8"),
+            (
+                header::CONTENT_DISPOSITION,
+                "attachment; filename=\"view.toml\"",
+            ),
+        ],
+        view.to_toml(),
+    )
+        .into_response())
+}
+
+fn latest(x: &Explorer, id: Option<u64>) -> Result<(obscura_render::Image, u32), ExploreError> {
+    let s = x
+        .session(id)?
+        .ok_or_else(|| ExploreError::BadRequest("no session named".into()))?;
+    s.latest_image()
+        .map(|(image, _, passes)| (image, passes))
+        .ok_or_else(|| ExploreError::NothingThere("no frame rendered yet".into()))
+}
+
+async fn image_png(State(x): Api, Query(q): Query<SessionQuery>) -> Result<Response, ExploreError> {
+    let (image, _) = latest(&x, q.session)?;
+    let png = blocking(move || png_bytes(&image)).await?;
+    Ok((
+        [
+            (header::CONTENT_TYPE, "image/png"),
+            (
+                header::CONTENT_DISPOSITION,
+                "attachment; filename=\"view.png\"",
+            ),
+        ],
+        png,
+    )
+        .into_response())
+}
+
+async fn image_exr(State(x): Api, Query(q): Query<SessionQuery>) -> Result<Response, ExploreError> {
+    let (image, passes) = latest(&x, q.session)?;
+    let exr = blocking(move || {
+        // The EXR writer writes files; a private temporary one, read back and removed.
+        let path = std::env::temp_dir().join(format!(
+            "obscura-explore-{}-{}.exr",
+            std::process::id(),
+            TEMP_COUNTER.fetch_add(1, Ordering::SeqCst)
+        ));
+        let info = ImageInfo {
+            partial: false,
+            samples_per_pixel: passes,
+        };
+        let written = write_image(&path, &image, &info).and_then(|()| {
+            std::fs::read(&path).map_err(|source| obscura_render::RenderError::Io {
+                file: path.clone(),
+                action: "cannot read back",
+                source,
+            })
+        });
+        let _ = std::fs::remove_file(&path);
+        Ok(written?)
+    })
+    .await?;
+    Ok((
+        [
+            (header::CONTENT_TYPE, "image/x-exr"),
+            (
+                header::CONTENT_DISPOSITION,
+                "attachment; filename=\"view.exr\"",
+            ),
+        ],
+        exr,
+    )
+        .into_response())
+}
+
+static TEMP_COUNTER: AtomicU64 = AtomicU64::new(0);
+
+#[derive(Deserialize)]
+struct PostprocessQuery {
+    session: Option<u64>,
+    effect: String,
+}
+
+/// Potmesil and Chakravarty's post-process blur of a pinhole image of the view, for
+/// comparison with the distributed render.
+async fn postprocess(
+    State(x): Api,
+    Query(q): Query<PostprocessQuery>,
+) -> Result<Response, ExploreError> {
+    let dof = match q.effect.as_str() {
+        "dof" => true,
+        "motion" => false,
+        other => {
+            return Err(ExploreError::BadRequest(format!(
+                "effect must be \"dof\" or \"motion\", got {other:?}"
+            )));
+        }
+    };
+    let view = x.view_of(q.session)?;
+    let threads = x.threads;
+    let png = blocking(move || {
+        let d = view.description();
+        let real = RenderScene::build(d.clone())?;
+        let buffers = screen_buffers(&real);
+        let open = d.camera.shutter.open;
+        let mut change = ViewChange {
+            spp: Some(d.sampler.spp.min(POSTPROCESS_SPP)),
+            ..Default::default()
+        };
+        change.camera.insert("shutter".into(), json!([open, open]));
+        if dof {
+            change.camera.insert("lens_radius".into(), json!(0.0));
+        }
+        let sharp = RenderScene::build(view.apply(&change)?.description().clone())?;
+        let outcome = render(
+            &sharp,
+            RenderOptions {
+                threads,
+                ..Default::default()
+            },
+        )
+        .map_err(|e| ExploreError::Internal(e.to_string()))?;
+        let image = outcome.film.resolve();
+        let blurred = if dof {
+            depth_of_field(
+                &image,
+                &buffers.depth,
+                &DepthOfField::for_camera(&real.camera)?,
+            )?
+        } else {
+            motion_blur(&image, &buffers.velocity)?
+        };
+        png_bytes(&blurred)
+    })
+    .await?;
+    Ok(([(header::CONTENT_TYPE, "image/png")], png).into_response())
+}
+
+async fn websocket(
+    State(x): Api,
+    Query(q): Query<SessionQuery>,
+    upgrade: WebSocketUpgrade,
+) -> Result<Response, ExploreError> {
+    // A named session is joined (and left open); otherwise the page gets its own, closed
+    // with the socket.
+    let joined = x.session(q.session)?;
+    let (id, session, owned) = match joined {
+        Some(s) => (q.session.unwrap_or_default(), s, false),
+        None => {
+            let (id, s) = x.open().await?;
+            (id, s, true)
+        }
+    };
+    Ok(upgrade.on_upgrade(move |socket| async move {
+        talk(socket, id, session).await;
+        if owned {
+            x.sessions().remove(&id);
+        }
+    }))
+}
+
+/// The socket's conversation: a hello, then frames out and changes in until either side
+/// closes.
+async fn talk(mut socket: WebSocket, id: u64, session: Arc<Session>) {
+    let mut hello = view_json(&session.view());
+    hello["type"] = json!("hello");
+    hello["session"] = json!(id);
+    if socket
+        .send(Message::Text(hello.to_string().into()))
+        .await
+        .is_err()
+    {
+        return;
+    }
+    let mut frames = session.frames();
+    loop {
+        tokio::select! {
+            changed = frames.changed() => {
+                if changed.is_err() {
+                    return;
+                }
+                let frame = frames.borrow_and_update().clone();
+                if let Some(f) = frame {
+                    let mut bytes = Vec::with_capacity(12 + f.png.len());
+                    bytes.extend_from_slice(&(f.generation as u32).to_le_bytes());
+                    bytes.extend_from_slice(&f.pass.to_le_bytes());
+                    bytes.extend_from_slice(&f.passes.to_le_bytes());
+                    bytes.extend_from_slice(&f.png);
+                    if socket.send(Message::Binary(bytes.into())).await.is_err() {
+                        return;
+                    }
+                }
+            }
+            incoming = socket.recv() => {
+                let text = match incoming {
+                    Some(Ok(Message::Text(t))) => t,
+                    Some(Ok(Message::Close(_))) | None | Some(Err(_)) => return,
+                    Some(Ok(_)) => continue,
+                };
+                let reply = match serde_json::from_str::<ViewChange>(text.as_str())
+                    .map_err(|e| ExploreError::BadRequest(e.to_string()))
+                    .and_then(|c| session.change(&c))
+                {
+                    Ok((generation, view)) => {
+                        let mut v = view_json(&view);
+                        v["type"] = json!("view");
+                        v["generation"] = json!(generation);
+                        v
+                    }
+                    Err(e) => {
+                        let mut v = e.body();
+                        v["type"] = json!("error");
+                        v
+                    }
+                };
+                if socket.send(Message::Text(reply.to_string().into())).await.is_err() {
+                    return;
+                }
+            }
+        }
+    }
+}
