@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Every test: the Rust workspace's, then the Python package's against the command line's renders.
-# The README's test command; .ci/run calls it. Installs the Python package (and pytest,
-# opencv-python-headless, numpy) into the active Python.
+# Every test: the Rust workspace's, the Python package's against the command line's renders,
+# and the browser explorer's end to end in headless Chromium. The README's test command;
+# .ci/run calls it. Installs the Python package (and pytest, opencv-python-headless, numpy) into
+# the active Python, and Debian's chromium, nodejs and npm when they are missing (as root).
 set -uo pipefail
 cd "$(dirname "$0")/.."
 mkdir -p target
@@ -21,7 +22,19 @@ OBSCURA_BIN="$PWD/target/release/obscura" python3 -m pytest -q crates/obscura-py
   | tee target/test-python.log
 [ "${PIPESTATUS[0]}" -eq 0 ] || status=1
 
+echo "== browser: tests/explore/run.sh (obscura serve driven by headless Chromium)"
+if ! [ -x /usr/bin/chromium ] || ! command -v npm >/dev/null 2>&1; then
+  if [ "$(id -u)" -eq 0 ]; then
+    apt-get update -qq && apt-get install -y -qq chromium nodejs npm >/dev/null || status=1
+  else
+    echo "tests: chromium, nodejs and npm are needed (apt-get install chromium nodejs npm)" >&2
+  fi
+fi
+bash tests/explore/run.sh 2>&1 | tee target/test-browser.log
+[ "${PIPESTATUS[0]}" -eq 0 ] || status=1
+
 # One closing line each: cargo's 'test result' lines summed, and pytest's own summary.
 awk '/^test result:/ { p += $4; f += $6; i += $8 } END { printf "rust tests: %d passed, %d failed, %d skipped\n", p, f, i }' target/test-rust.log
 echo "python tests: $(tail -n 1 target/test-python.log)"
+echo "browser tests: $(tail -n 1 target/test-browser.log)"
 exit "$status"
