@@ -30,13 +30,15 @@ fi
 # Seeds that need the renderer: a tiny EXR and a tiny checkpoint of a shipped scene.
 gen=fuzz/seeds/generated
 mkdir -p "$gen" fuzz/logs
-if [ ! -s "$gen/tiny.exr" ] || [ ! -s "$gen/tiny.ckpt" ]; then
+if [ ! -s "$gen/tiny.exr" ] || [ ! -s "$gen/tiny.ckpt" ] || [ ! -s "$gen/tiny.part" ]; then
     cargo build --release --quiet
     bin=target/release/obscura
     "$bin" render scenes/spheres-perspective.toml --resolution 4x2 --spp 1 -o "$gen/tiny.exr" >/dev/null
     "$bin" render scenes/spheres-perspective.toml --resolution 4x2 --spp 2 -o "$gen/ckpt.exr" \
         --checkpoint "$gen/tiny.ckpt" --checkpoint-every 0 >/dev/null
     rm -f "$gen/ckpt.exr"
+    "$bin" render scenes/spheres-perspective.toml --resolution 4x2 --spp 4 --slice 1/2 \
+        -o "$gen/tiny.part" >/dev/null
 fi
 
 seeds_of() {
@@ -45,11 +47,14 @@ seeds_of() {
         obj) echo fuzz/seeds/obj tests/bad-input/models ;;
         exr) echo "$gen/exr" ;;
         checkpoint) echo "$gen/ckpt" ;;
+        partial) echo "$gen/part" ;;
+        pbrt) echo scenes ;;
+        mitsuba) echo scenes ;;
         *) [ -d "fuzz/seeds/$1" ] && echo "fuzz/seeds/$1" ;;
     esac
 }
-mkdir -p "$gen/exr" "$gen/ckpt"
-cp "$gen/tiny.exr" "$gen/exr/" && cp "$gen/tiny.ckpt" "$gen/ckpt/"
+mkdir -p "$gen/exr" "$gen/ckpt" "$gen/part"
+cp "$gen/tiny.exr" "$gen/exr/" && cp "$gen/tiny.ckpt" "$gen/ckpt/" && cp "$gen/tiny.part" "$gen/part/"
 
 status=0
 for t in "${targets[@]}"; do

@@ -158,9 +158,34 @@ pub fn read_exr(path: &Path) -> Result<(Image, bool), RenderError> {
     decode_exr(&bytes, path)
 }
 
+/// The most pixels an EXR read here may declare (2 GiB of RGBA floats): a header that claims
+/// more is refused before any pixel memory is allocated, so a corrupt or hostile size cannot
+/// abort the process.
+pub const MAX_EXR_PIXELS: u64 = 1 << 27;
+
 /// [`read_exr`] of a file's bytes; `path` names the file in errors.
 pub fn decode_exr(bytes: &[u8], path: &Path) -> Result<(Image, bool), RenderError> {
     use exr::prelude::*;
+    // The headers first: the pixel reader allocates the declared size up front.
+    let meta = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(bytes), false)
+        .map_err(|e| RenderError::Encode {
+            file: path.to_path_buf(),
+            message: format!("cannot read EXR: {e}"),
+        })?;
+    for header in meta.headers.iter() {
+        let size = header.layer_size;
+        let pixels = size.width() as u64 * size.height() as u64;
+        if pixels > MAX_EXR_PIXELS {
+            return Err(RenderError::Encode {
+                file: path.to_path_buf(),
+                message: format!(
+                    "cannot read EXR: its header declares {} x {} pixels, more than the {MAX_EXR_PIXELS} this reader accepts",
+                    size.width(),
+                    size.height()
+                ),
+            });
+        }
+    }
     let img = read()
         .no_deep_data()
         .largest_resolution_level()
