@@ -29,7 +29,7 @@ while [ "$landed" -lt "$cycles" ]; do
     resume=()
     [ -f "$dir/soak.ckpt" ] && resume=(--resume "$dir/soak.ckpt")
     "$bin" render "$scene" -o "$dir/out.exr" "${flags[@]}" \
-        --checkpoint "$dir/soak.ckpt" --checkpoint-every 0 "${resume[@]}" >/dev/null 2>"$dir/err" &
+        --checkpoint "$dir/soak.ckpt" --checkpoint-every 0 "${resume[@]}" >"$dir/out" 2>"$dir/err" &
     pid=$!
     sleep "0.$(printf '%03d' $((RANDOM % 200)))"
     kill -INT "$pid" 2>/dev/null || true
@@ -40,7 +40,8 @@ while [ "$landed" -lt "$cycles" ]; do
     runs=$((runs + 1))
     case $code in
         130) landed=$((landed + 1)) ;;
-        0) echo "the render finished after $landed interrupts; use a larger --spp" >&2; exit 1 ;;
+        0) echo "the render finished after $landed interrupts; use a larger --spp" >&2
+           cat "$dir/out" "$dir/err" >&2; exit 1 ;;
         # SIGINT before the handlers were installed: the default action, no checkpoint change.
         *) if grep -q . "$dir/err"; then cat "$dir/err" >&2; echo "exit $code" >&2; exit 1; fi
            early=$((early + 1)) ;;
@@ -48,7 +49,7 @@ while [ "$landed" -lt "$cycles" ]; do
 done
 "$bin" render "$scene" -o "$dir/out.exr" "${flags[@]}" --checkpoint "$dir/soak.ckpt" \
     --resume "$dir/soak.ckpt" >/dev/null
-rm -f "$dir/err"
+rm -f "$dir/err" "$dir/out"
 if ! cmp -s "$dir/out.exr" "$dir/straight.exr"; then
     echo "FAIL: the resumed image differs from the straight render" >&2
     exit 1

@@ -23,9 +23,7 @@
 
 use crate::error::RenderError;
 use crate::film::{Film, PixelRect, PixelSums};
-use crate::output::temporary_beside;
 use crate::scene::SceneDescription;
-use std::io::Write;
 use std::path::Path;
 
 /// The first eight bytes of a checkpoint file.
@@ -151,27 +149,14 @@ impl Checkpoint {
     /// Writes the checkpoint to `path` atomically (a temporary file beside it, flushed to disk,
     /// then renamed over it): a crash mid-write leaves the previous checkpoint intact.
     pub fn save(&self, path: &Path) -> Result<(), RenderError> {
-        let tmp = temporary_beside(path);
-        let io = |action: &'static str| {
-            move |source| RenderError::Io {
-                file: path.to_path_buf(),
-                action,
-                source,
-            }
-        };
-        let written = std::fs::File::create(&tmp)
-            .and_then(|mut f| {
-                f.write_all(&self.to_bytes())?;
-                f.sync_all()
-            })
-            .map_err(io("cannot write the checkpoint"))
-            .and_then(|()| {
-                std::fs::rename(&tmp, path).map_err(io("cannot move the checkpoint into place"))
-            });
-        if written.is_err() {
-            let _ = std::fs::remove_file(&tmp);
-        }
-        written
+        crate::output::write_whole(
+            path,
+            &self.to_bytes(),
+            [
+                "cannot write the checkpoint",
+                "cannot move the checkpoint into place",
+            ],
+        )
     }
 
     /// Reads a checkpoint file.

@@ -221,6 +221,35 @@ pub fn decode_exr(bytes: &[u8], path: &Path) -> Result<(Image, bool), RenderErro
     ))
 }
 
+/// Writes `bytes` to `path` whole or not at all: a temporary file beside it, flushed to disk,
+/// then renamed over it, so a crash mid-write leaves the previous file intact. `actions` name
+/// the write and the rename in errors.
+pub(crate) fn write_whole(
+    path: &Path,
+    bytes: &[u8],
+    actions: [&'static str; 2],
+) -> Result<(), RenderError> {
+    let tmp = temporary_beside(path);
+    let io = |action: &'static str| {
+        move |source| RenderError::Io {
+            file: path.to_path_buf(),
+            action,
+            source,
+        }
+    };
+    let written = std::fs::File::create(&tmp)
+        .and_then(|mut f| {
+            std::io::Write::write_all(&mut f, bytes)?;
+            f.sync_all()
+        })
+        .map_err(io(actions[0]))
+        .and_then(|()| std::fs::rename(&tmp, path).map_err(io(actions[1])));
+    if written.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    written
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

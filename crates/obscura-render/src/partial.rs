@@ -28,10 +28,8 @@
 use crate::checkpoint::{Reader, check_length_and_checksum, put_sums, seal, take_film};
 use crate::error::RenderError;
 use crate::film::{Film, PixelRect};
-use crate::output::temporary_beside;
 use crate::scene::IntegratorKind;
 use std::fmt;
-use std::io::Write;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
@@ -264,27 +262,14 @@ impl Partial {
     /// Writes the partial to `path` whole or not at all (a temporary file beside it, flushed
     /// to disk, then renamed over it).
     pub fn save(&self, path: &Path) -> Result<(), RenderError> {
-        let tmp = temporary_beside(path);
-        let io = |action: &'static str| {
-            move |source| RenderError::Io {
-                file: path.to_path_buf(),
-                action,
-                source,
-            }
-        };
-        let written = std::fs::File::create(&tmp)
-            .and_then(|mut f| {
-                f.write_all(&self.to_bytes())?;
-                f.sync_all()
-            })
-            .map_err(io("cannot write the partial"))
-            .and_then(|()| {
-                std::fs::rename(&tmp, path).map_err(io("cannot move the partial into place"))
-            });
-        if written.is_err() {
-            let _ = std::fs::remove_file(&tmp);
-        }
-        written
+        crate::output::write_whole(
+            path,
+            &self.to_bytes(),
+            [
+                "cannot write the partial",
+                "cannot move the partial into place",
+            ],
+        )
     }
 
     /// Reads a partial file.
