@@ -232,3 +232,54 @@ fn opencv_models_match_cv2() {
     }
     println!("cv2 agreement: max {max_px:.2e} px, rays within {max_angle:.2e} rad");
 }
+
+/// Found by the `camera` fuzz target: extreme but finite intrinsics and distortion carried a
+/// projected point past f32's range, and `project` returned an infinite raster position. Such
+/// a point now projects to None; every position returned is finite.
+#[test]
+fn projections_beyond_f32_range_are_none_not_infinite() {
+    let text = r#"[film]
+resolution = [33, 102]
+[camera]
+type = "opencv"
+fx = 2.6185948e20
+fy = 2.7946379e20
+cx = 1.7750712e28
+cy = 2.7943687e20
+distortion = [1.9443517e31, 1.567235e-1, 8.480155e-33, 4.2324086e21]
+rvec = [1.2397067e28, 7.1433342e31, 1.3043435e-11]
+tvec = [1.8887691e31, 1.6634979e22, 5.5356084e-11]
+shutter = [5.5356084e-11, 1.148167e27]
+near = 1.5773086e-19
+"#;
+    let d = obscura_render::parse_description(std::path::Path::new("fuzz.toml"), text).unwrap();
+    let camera = obscura_render::camera_of(&d).unwrap();
+    // Film points far outside the image too, as the fuzzer drew them.
+    let coords: Vec<f32> = [0.5f32, 16.0, 1e3, 1e6, 1e12, 1e20, 1e28, 1e32]
+        .iter()
+        .flat_map(|&c| [c, -c])
+        .collect();
+    let mut rays = 0;
+    for &x in &coords {
+        for &y in &coords {
+            let Some(r) = camera.generate_ray(&CameraSample::at(Point2::new(x, y))) else {
+                continue;
+            };
+            rays += 1;
+            let p = r.ray.origin + r.ray.direction * 2.0;
+            if let Some(xy) = camera.project(p, camera.shutter().open) {
+                assert!(xy.x.is_finite() && xy.y.is_finite(), "({x}, {y}) -> {xy:?}");
+            }
+        }
+    }
+    assert!(
+        rays > 0,
+        "the camera made no ray: the check above ran on nothing"
+    );
+    // The fuzzer's point: its projection overflowed to (8.6e33, inf) before the fix.
+    let r = camera
+        .generate_ray(&CameraSample::at(Point2::new(0.5, -1e20)))
+        .expect("a ray leaves there");
+    let p = r.ray.origin + r.ray.direction * 2.0;
+    assert_eq!(camera.project(p, camera.shutter().open), None);
+}

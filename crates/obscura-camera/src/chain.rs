@@ -199,3 +199,11 @@ pub(crate) fn direction_within_clip(base: &CameraBase, v: DVec3) -> Option<DVec3
     }
     Some(v / distance)
 }
+
+/// A raster position computed in f64 as the f32 point `project` returns; None when it does not
+/// fit in an f32 (extreme intrinsics or distortion can carry a point past 3.4e38 pixels).
+#[inline]
+pub(crate) fn raster_f32(r: glam::DVec2) -> Option<Point2<Raster>> {
+    let p = Point2::new(r.x as f32, r.y as f32);
+    (p.x.is_finite() && p.y.is_finite()).then_some(p)
+}

@@ -244,8 +244,7 @@ impl Camera for OpenCvFisheyeCamera {
             return None;
         }
         let v = chain::camera_point(&self.base, &self.pose, p, time);
-        let r = self.project_camera(v)?;
-        Some(Point2::new(r.x as f32, r.y as f32))
+        chain::raster_f32(self.project_camera(v)?)
     }
 
     fn uses_lens_sample(&self) -> bool {
