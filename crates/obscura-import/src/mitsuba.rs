@@ -567,6 +567,7 @@ impl<'d, 'i> Mitsuba<'d, 'i> {
             shutter: shutter.map(|x| x as f32),
             near: Some(near as f32),
             far: Some(far as f32),
+            realistic: None,
         };
         match kind.as_str() {
             "perspective" | "thinlens" => {

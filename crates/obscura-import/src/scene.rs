@@ -34,6 +34,9 @@ pub(crate) struct CameraIr {
     pub(crate) shutter: [f32; 2],
     pub(crate) near: Option<f32>,
     pub(crate) far: Option<f32>,
+    /// A lens system (pbrt's `realistic`): the lens file's path, resolved against the scene
+    /// file's folder, and `aperture_diameter`, `focus_distance`, `film_diagonal`.
+    pub(crate) realistic: Option<(std::path::PathBuf, f32, f32, f32)>,
 }
 
 /// A material in the scene format's terms.
@@ -511,6 +514,12 @@ fn emit(
     }
     if let Some(f) = camera.focal_distance {
         let _ = writeln!(out, "focal_distance = {}", num(f));
+    }
+    if let Some((file, aperture, focus, diagonal)) = &camera.realistic {
+        let _ = writeln!(out, "lens_file = {}", quote(&file.to_string_lossy()));
+        let _ = writeln!(out, "aperture_diameter = {}", num(*aperture));
+        let _ = writeln!(out, "focus_distance = {}", num(*focus));
+        let _ = writeln!(out, "film_diagonal = {}", num(*diagonal));
     }
     if let Some(n) = camera.near {
         let _ = writeln!(out, "near = {}", num(n));

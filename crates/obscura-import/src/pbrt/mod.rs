@@ -1302,6 +1302,8 @@ impl Pbrt {
             self.ir.warn(loc, "AttributeBegin without AttributeEnd");
         }
         let film_loc = self.film.as_ref().map(|f| f.1.clone());
+        // pbrt's film diagonal in mm, which only its realistic camera reads.
+        let mut film_diagonal = 35.0;
         let mut film = self.ir.film.take().unwrap_or(FilmIr {
             resolution: [1280, 720],
             crop: None,
@@ -1329,12 +1331,12 @@ impl Pbrt {
                 );
             }
             let _ = p.string("filename")?;
+            film_diagonal = p.num_or("diagonal", 35.0)?;
             for k in [
                 "iso",
                 "exposuretime",
                 "whitebalance",
                 "sensor",
-                "diagonal",
                 "savefp16",
                 "maxcomponentvalue",
             ] {
@@ -1386,6 +1388,7 @@ impl Pbrt {
             shutter: [shutter[0] as f32, shutter[1] as f32],
             near: None,
             far: None,
+            realistic: None,
         };
         let window = |p: &Params| -> Result<Option<[f32; 4]>, ImportError> {
             if let Some(w) = p.fixed::<4>("screenwindow")? {
@@ -1439,9 +1442,24 @@ impl Pbrt {
                 cam.pose *= p_from_obscura;
                 cam.pose_end = cam.pose_end.map(|m| m * p_from_obscura);
             }
+            "realistic" => {
+                // pbrt-v4's parameters and defaults: lensfile (relative to the scene file),
+                // aperturediameter 1 mm, focusdistance 10; the film's diagonal (35 mm).
+                let Some(file) = p.string("lensfile")? else {
+                    return Err(loc.error("Camera \"realistic\": \"string lensfile\" is required"));
+                };
+                let folder = loc.file.parent().unwrap_or(Path::new("."));
+                cam.kind = "realistic";
+                cam.realistic = Some((
+                    folder.join(file),
+                    p.num_or("aperturediameter", 1.0)? as f32,
+                    p.num_or("focusdistance", 10.0)? as f32,
+                    film_diagonal as f32,
+                ));
+            }
             other => {
                 return Err(loc.error(format!(
-                    "Camera \"{other}\": not supported (perspective, orthographic, spherical)"
+                    "Camera \"{other}\": not supported (perspective, orthographic, spherical, realistic)"
                 )));
             }
         }

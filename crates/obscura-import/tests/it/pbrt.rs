@@ -827,3 +827,51 @@ fn image_infinite_lights_keep_pbrts_equal_area_orientation() {
     let converted = look(obscura_render::load_description(&out).unwrap());
     assert_eq!(converted.pixels, image.pixels);
 }
+
+#[test]
+fn the_realistic_camera_takes_pbrts_parameters_and_defaults() {
+    let dir = scratch("pbrt-realistic");
+    let lens = include_str!("../../../../scenes/lenses/double-gauss-50mm.dat");
+    std::fs::create_dir_all(dir.join("lenses")).unwrap();
+    write(&dir.join("lenses"), "dgauss.dat", lens);
+    let scene = "LookAt 0 0 5  0 0 0  0 1 0\n\
+                 Camera \"realistic\" \"string lensfile\" \"lenses/dgauss.dat\" \
+                 \"float aperturediameter\" 6 \"float focusdistance\" 5\n\
+                 Film \"rgb\" \"integer xresolution\" 32 \"integer yresolution\" 24 \
+                 \"float diagonal\" 30\nWorldBegin\nShape \"sphere\"";
+    let path = write(&dir, "realistic.pbrt", scene);
+    let d = parse_pbrt(&path, scene).unwrap().description().unwrap();
+    assert_eq!(d.camera.kind, CameraKind::Realistic);
+    let r = d.camera.realistic.as_ref().unwrap();
+    assert_eq!(r.lens_file, dir.join("lenses/dgauss.dat"));
+    assert_eq!(
+        (r.aperture_diameter, r.focus_distance, r.film_diagonal),
+        (Some(6.0), 5.0, 30.0)
+    );
+    // The film centre's ray through the lens centre looks down the LookAt line.
+    let camera = camera_of(&d).unwrap();
+    let ray = (0..64)
+        .find_map(|k| {
+            let u = (k as f32 + 0.5) / 64.0;
+            camera.generate_ray(&obscura_camera::CameraSample {
+                p_film: obscura_space::Point2::new(16.0, 12.0),
+                p_lens: glam::Vec2::new(u, 0.5),
+                time: 0.0,
+            })
+        })
+        .expect("some lens sample passes the stop")
+        .ray;
+    assert!(ray.direction.z < -0.99, "{:?}", ray.direction);
+
+    // pbrt's defaults: aperture 1 mm, focus 10, diagonal 35; the lens file is required.
+    let scene = "Camera \"realistic\" \"string lensfile\" \"lenses/dgauss.dat\"\nWorldBegin";
+    let path = write(&dir, "defaults.pbrt", scene);
+    let d = parse_pbrt(&path, scene).unwrap().description().unwrap();
+    let r = d.camera.realistic.as_ref().unwrap();
+    assert_eq!(
+        (r.aperture_diameter, r.focus_distance, r.film_diagonal),
+        (Some(1.0), 10.0, 35.0)
+    );
+    let e = import_err("Camera \"realistic\"\nWorldBegin");
+    assert!(e.to_string().contains("lensfile"), "{e}");
+}
