@@ -20,9 +20,10 @@ const CONTROLS = [
   { key: 'lens_radius', kind: 'range', min: 0, max: 1, step: 0.005, def: 0, models: PROJECTIVE },
   { key: 'focal_distance', kind: 'range', min: 0.05, max: 50, step: 0.01, def: 1,
     models: PROJECTIVE },
-  { key: 'aperture_blades', kind: 'int', min: 0, max: 64, def: 0, models: PROJECTIVE },
+  { key: 'aperture_blades', kind: 'int', min: 0, max: 64, def: 0,
+    models: [...PROJECTIVE, 'realistic'] },
   { key: 'aperture_rotation', kind: 'range', min: 0, max: 360, step: 1, def: 0,
-    models: PROJECTIVE },
+    models: [...PROJECTIVE, 'realistic'] },
   { key: 'shutter', kind: 'vec', n: 2, def: [0, 1] },
   { key: 'eye_end', kind: 'vec', n: 3, optional: true },
   { key: 'target_end', kind: 'vec', n: 3, optional: true },
@@ -40,6 +41,21 @@ const CONTROLS = [
   { key: 'cx', kind: 'number', models: OPENCV },
   { key: 'cy', kind: 'number', models: OPENCV },
   { key: 'distortion', kind: 'list', models: OPENCV },
+  { key: 'aperture_image', kind: 'text', optional: true, models: PROJECTIVE },
+  { key: 'anamorphic', kind: 'number', def: 1, models: PROJECTIVE },
+  { key: 'focal_plane_tilt', kind: 'vec', n: 2, def: [0, 0], models: ['perspective'] },
+  { key: 'focal_length', kind: 'number', optional: true, models: PROJECTIVE },
+  { key: 'shutter_curve', kind: 'json', optional: true, placeholder: '[[0, 0], [0.5, 1], [1, 0]]' },
+  { key: 'rolling_shutter', kind: 'json', optional: true,
+    placeholder: '{"readout": 0.5, "direction": "top_to_bottom"}' },
+  { key: 'f_number', kind: 'number', optional: true },
+  { key: 'shutter_time', kind: 'number', optional: true },
+  { key: 'iso', kind: 'number', optional: true },
+  { key: 'exposure_compensation', kind: 'number', optional: true },
+  { key: 'lens_file', kind: 'text', models: ['realistic'] },
+  { key: 'aperture_diameter', kind: 'number', optional: true, models: ['realistic'] },
+  { key: 'focus_distance', kind: 'number', def: 10, models: ['realistic'] },
+  { key: 'film_diagonal', kind: 'number', def: 35, models: ['realistic'] },
 ];
 
 const $ = (id) => document.getElementById(id);
@@ -132,6 +148,21 @@ function buildControls(types) {
         setCamera(c.key, v);
       });
       label.append(input);
+    } else if (c.kind === 'text' || c.kind === 'json') {
+      // A string (a file name, relative to the scene file) or a value written as JSON (a
+      // curve of [t, openness] pairs, a table).
+      const input = document.createElement('input');
+      Object.assign(input, { type: 'text', id: 'c-' + c.key, size: 16,
+        placeholder: c.placeholder || (c.optional ? '(none)' : '') });
+      input.addEventListener('change', () => {
+        const text = input.value.trim();
+        if (text === '' && c.optional) return setCamera(c.key, null);
+        if (c.kind === 'text') return setCamera(c.key, text);
+        let v;
+        try { v = JSON.parse(text); } catch (e) { return showError(`${c.key}: ${e.message}`); }
+        setCamera(c.key, v);
+      });
+      label.append(input);
     }
     fs.append(label);
   }
@@ -152,6 +183,7 @@ function showControls() {
     if (document.activeElement === input && c.kind !== 'range') continue;
     const v = valueOf(c.key);
     if (c.kind === 'vec' || c.kind === 'list') input.value = v === undefined ? '' : v.map(fmt).join(', ');
+    else if (c.kind === 'json') input.value = v === undefined ? '' : JSON.stringify(v);
     else if (v !== undefined) input.value = v;
     if (c.kind === 'range') label.querySelector('output').textContent = fmt(Number(input.value));
   }
