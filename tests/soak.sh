@@ -20,8 +20,8 @@ cargo build --release --quiet
 bin=$PWD/target/release/obscura
 dir=$(mktemp -d /tmp/obscura-soak.XXXXXX)
 trap 'rm -rf "$dir"' EXIT
-# Large enough that 100 interrupts land before the end (about a minute straight, two cores).
-flags=(--resolution 160x120 --spp 16384 --threads 2)
+# Large enough that 100 interrupts land before the end (a minute or two straight, two cores).
+flags=(--resolution 160x120 --spp 4096 --threads 2)
 
 "$bin" render "$scene" -o "$dir/straight.exr" "${flags[@]}" >/dev/null
 landed=0 runs=0 early=0
@@ -31,6 +31,8 @@ while [ "$landed" -lt "$cycles" ]; do
     "$bin" render "$scene" -o "$dir/out.exr" "${flags[@]}" \
         --checkpoint "$dir/soak.ckpt" --checkpoint-every 0 "${resume[@]}" >"$dir/out" 2>"$dir/err" &
     pid=$!
+    # Signal the render, not the shell that is about to exec it (a signal there can be lost).
+    while [ "$(readlink "/proc/$pid/exe" 2>/dev/null)" != "$bin" ] && kill -0 "$pid" 2>/dev/null; do :; done
     sleep "0.$(printf '%03d' $((RANDOM % 200)))"
     kill -INT "$pid" 2>/dev/null || true
     set +e
