@@ -28,7 +28,9 @@ landed=0 runs=0 early=0
 while [ "$landed" -lt "$cycles" ]; do
     resume=()
     [ -f "$dir/soak.ckpt" ] && resume=(--resume "$dir/soak.ckpt")
-    "$bin" render "$scene" -o "$dir/out.exr" "${flags[@]}" \
+    # SIGINT at its default action, even when this script was started with it ignored (as a
+    # background job of a non-interactive shell is): an early signal must stop the render.
+    env --default-signal=INT "$bin" render "$scene" -o "$dir/out.exr" "${flags[@]}" \
         --checkpoint "$dir/soak.ckpt" --checkpoint-every 0 "${resume[@]}" >"$dir/out" 2>"$dir/err" &
     pid=$!
     # Signal the render, not the shell that is about to exec it (a signal there can be lost).
