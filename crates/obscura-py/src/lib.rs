@@ -305,6 +305,32 @@ fn ray_arrays<'py>(
     ))
 }
 
+/// Fills `arrays` with the rays of `sample` ([`fill_rays`]) with the GIL released, and returns
+/// them as the `(origins, directions, valid)` tuple, with the first sample index whose input
+/// was not finite.
+fn trace_into<'py>(
+    py: Python<'py>,
+    camera: &AnyCamera,
+    arrays: RayArrays<'py>,
+    sample: impl Fn(usize) -> Option<CameraSample> + Sync + Send,
+) -> PyResult<(Bound<'py, PyTuple>, Option<usize>)> {
+    let (o_arr, d_arr, v_arr) = arrays;
+    let bad = {
+        let (mut o_rw, mut d_rw, mut v_rw) = (
+            writable(&o_arr, "origins")?,
+            writable(&d_arr, "directions")?,
+            writable(&v_arr, "valid")?,
+        );
+        let (o, d, v) = (
+            o_rw.as_slice_mut()?,
+            d_rw.as_slice_mut()?,
+            v_rw.as_slice_mut()?,
+        );
+        py.allow_threads(|| fill_rays(camera, sample, o, d, v))
+    };
+    Ok(((o_arr, d_arr, v_arr).into_pyobject(py)?, bad))
+}
+
 /// The (raster_xy, valid) arrays of `project`.
 type ProjectArrays<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray1<bool>>);
 
@@ -578,50 +604,29 @@ impl PyCamera {
         };
         let lens = lens_view.as_ref().map(|l| l.as_slice()).transpose()?;
         let time = time.map(|t| per_ray(t, "time", n)).transpose()?;
-        let (o_arr, d_arr, v_arr) = ray_arrays(py, out, n)?;
-        let (mut o_rw, mut d_rw, mut v_rw) = (
-            writable(&o_arr, "origins")?,
-            writable(&d_arr, "directions")?,
-            writable(&v_arr, "valid")?,
-        );
-        let (o, d, v) = (
-            o_rw.as_slice_mut()?,
-            d_rw.as_slice_mut()?,
-            v_rw.as_slice_mut()?,
-        );
-        let camera = &self.camera;
-        let bad = py.allow_threads(|| {
-            fill_rays(
-                camera,
-                |i| {
-                    let (x, y) = (film[2 * i], film[2 * i + 1]);
-                    if !(x.is_finite() && y.is_finite()) {
-                        return None;
-                    }
-                    let mut s = CameraSample::at(Point2::new(x, y));
-                    if let Some(l) = lens {
-                        let (u, w) = (l[2 * i], l[2 * i + 1]);
-                        if !(u.is_finite() && w.is_finite()) {
-                            return None;
-                        }
-                        s.p_lens = glam::Vec2::new(u, w);
-                    }
-                    if let Some(t) = &time {
-                        s.time = t[i];
-                    }
-                    Some(s)
-                },
-                o,
-                d,
-                v,
-            )
-        });
+        let (rays, bad) = trace_into(py, &self.camera, ray_arrays(py, out, n)?, |i| {
+            let (x, y) = (film[2 * i], film[2 * i + 1]);
+            if !(x.is_finite() && y.is_finite()) {
+                return None;
+            }
+            let mut s = CameraSample::at(Point2::new(x, y));
+            if let Some(l) = lens {
+                let (u, w) = (l[2 * i], l[2 * i + 1]);
+                if !(u.is_finite() && w.is_finite()) {
+                    return None;
+                }
+                s.p_lens = glam::Vec2::new(u, w);
+            }
+            if let Some(t) = &time {
+                s.time = t[i];
+            }
+            Some(s)
+        })?;
         if let Some(i) = bad {
             let film_ok = film[2 * i].is_finite() && film[2 * i + 1].is_finite();
             return Err(not_finite(if film_ok { "lens_uv" } else { "raster_xy" }, i));
         }
-        drop((o_rw, d_rw, v_rw));
-        (o_arr, d_arr, v_arr).into_pyobject(py)
+        Ok(rays)
     }
 
     /// cam.project(points, time=None, out=None) -> (raster_xy, valid)
@@ -714,40 +719,21 @@ impl PyCamera {
         let uses_time = camera.uses_time_sample() && camera.world_from_camera().is_animated();
         let spp_us = spp as usize;
         let w_us = w as usize;
-        let (o_arr, d_arr, v_arr) = ray_arrays(py, out, n as usize)?;
-        let (mut o_rw, mut d_rw, mut v_rw) = (
-            writable(&o_arr, "origins")?,
-            writable(&d_arr, "directions")?,
-            writable(&v_arr, "valid")?,
-        );
-        let (o, d, v) = (
-            o_rw.as_slice_mut()?,
-            d_rw.as_slice_mut()?,
-            v_rw.as_slice_mut()?,
-        );
-        py.allow_threads(|| {
-            fill_rays(
-                camera,
-                |i| {
-                    let s = (i % spp_us) as u32;
-                    let pixel = i / spp_us;
-                    let x = x0 + (pixel % w_us) as u32;
-                    let y = y0 + (pixel / w_us) as u32;
-                    let mut stream = sampler.stream([x, y], s);
-                    Some(CameraSample::from_stream(
-                        &mut stream,
-                        [x, y],
-                        uses_lens,
-                        uses_time,
-                    ))
-                },
-                o,
-                d,
-                v,
-            )
-        });
-        drop((o_rw, d_rw, v_rw));
-        (o_arr, d_arr, v_arr).into_pyobject(py)
+        let arrays = ray_arrays(py, out, n as usize)?;
+        let (rays, _) = trace_into(py, camera, arrays, |i| {
+            let s = (i % spp_us) as u32;
+            let pixel = i / spp_us;
+            let x = x0 + (pixel % w_us) as u32;
+            let y = y0 + (pixel / w_us) as u32;
+            let mut stream = sampler.stream([x, y], s);
+            Some(CameraSample::from_stream(
+                &mut stream,
+                [x, y],
+                uses_lens,
+                uses_time,
+            ))
+        })?;
+        Ok(rays)
     }
 }
 
