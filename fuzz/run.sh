@@ -68,7 +68,14 @@ for t in "${targets[@]}"; do
         -print_final_stats=1 "${dict[@]}" >"fuzz/logs/$t.log" 2>&1; then
         status=1
     fi
-    "${fuzz[@]}" cmin "$t" "$corpus" >"fuzz/logs/$t.cmin.log" 2>&1 || true
+    # Keep the smallest set of inputs that covers every feature (libFuzzer's set-cover merge),
+    # so the corpus stays small enough to commit.
+    min=$(mktemp -d)
+    if "${fuzz[@]}" run "$t" "$min" "$corpus" -- -set_cover_merge=1 -rss_limit_mb=4096 \
+        >"fuzz/logs/$t.cmin.log" 2>&1; then
+        rm -rf "$corpus" && mkdir -p "$corpus" && cp "$min"/* "$corpus"/ 2>/dev/null || true
+    fi
+    rm -rf "$min"
     execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "fuzz/logs/$t.log" | grep -o '[0-9]*$' || echo '?')
     cov=$(grep -o 'cov: [0-9]* ft: [0-9]*' "fuzz/logs/$t.log" | tail -1 || echo 'cov: ?')
     crashes=$(find "fuzz/artifacts/$t" -type f 2>/dev/null | wc -l)
