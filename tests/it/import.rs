@@ -25,6 +25,12 @@ fn imported(name: &str) -> SceneDescription {
 fn shipped_pbrt_and_mitsuba_scenes_match_the_shipped_toml() {
     let reference = shipped("spheres-perspective.toml");
     for name in ["spheres-perspective.pbrt", "spheres-perspective.xml"] {
+        // The same path length: pbrt counts bounces as we do, Mitsuba one more.
+        assert_eq!(
+            imported(name).integrator.max_depth,
+            reference.integrator.max_depth,
+            "{name}"
+        );
         for kind in [IntegratorKind::Depth, IntegratorKind::Position] {
             // The same samples on both sides: the formats' samplers differ.
             let small = |mut d: SceneDescription| {

@@ -412,7 +412,15 @@ impl<'d, 'i> Mitsuba<'d, 'i> {
         }
         let depth = match (kind.as_str(), self.float(n, "max_depth")?) {
             ("direct", _) => 1.0,
-            (_, Some(d)) if d >= 1.0 => d,
+            // Mitsuba counts path vertices after the camera, the emitter's included (1 shows
+            // emitters only, 2 adds direct light); Obscura counts bounces (0 and 1).
+            (_, Some(d)) if d >= 2.0 => d - 1.0,
+            (_, Some(d)) if d >= 1.0 => {
+                return Err(loc.error(
+                    "<integrator>: max_depth 1 (emitters only, no bounce) has no Obscura \
+                     equivalent: its path tracer takes at least one bounce (Mitsuba's 2)",
+                ));
+            }
             (_, Some(-1.0)) => {
                 self.ir.warn(
                     &loc,

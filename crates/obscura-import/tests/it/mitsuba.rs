@@ -482,3 +482,32 @@ fn envmaps_keep_mitsubas_orientation() {
         "{towards_minus_x:?}"
     );
 }
+
+#[test]
+fn max_depth_counts_the_emitter_vertex_as_mitsuba_does() {
+    // Mitsuba 3's documentation: max_depth 1 renders only directly visible emitters, 2 adds
+    // direct illumination. Obscura's max_depth counts bounces (1 is direct illumination) and
+    // has no emitters-only setting, so Mitsuba's 1 is refused with the line.
+    for (mitsuba, ours) in [(2, 1), (3, 2), (7, 6)] {
+        let d = import(&format!(
+            r#"<scene version="3.0.0"><integrator type="path">
+                <integer name="max_depth" value="{mitsuba}"/></integrator>
+                <sensor type="perspective"/></scene>"#
+        ))
+        .description()
+        .unwrap();
+        assert_eq!(d.integrator.max_depth, ours, "Mitsuba max_depth {mitsuba}");
+    }
+    let d = import(
+        r#"<scene version="3.0.0"><integrator type="direct"/><sensor type="perspective"/></scene>"#,
+    )
+    .description()
+    .unwrap();
+    assert_eq!(d.integrator.max_depth, 1);
+    let e = import_err(
+        r#"<scene version="3.0.0"><integrator type="path">
+            <integer name="max_depth" value="1"/></integrator><sensor type="perspective"/></scene>"#,
+    );
+    assert!(e.to_string().contains("max_depth 1"), "{e}");
+    assert_eq!(line_of(&e), Some(1));
+}
