@@ -67,7 +67,7 @@ mod material;
 
 pub use error::ShadeError;
 pub use frame::Frame;
-pub use integrator::{PathIntegrator, SampleDims, ShadingScene, power_heuristic};
+pub use integrator::{PathIntegrator, SampleDims, ShadingScene, power_heuristic, rr_survival};
 pub use light::{
     AreaLight, EnvironmentLight, Light, LightSample, direction_to_uv, luminance, uv_to_direction,
 };

@@ -58,6 +58,10 @@ pub struct BsdfSample {
     pub pdf: f32,
     /// True for a delta lobe (mirror, glass): MIS and light sampling do not apply.
     pub specular: bool,
+    /// The relative index of refraction crossed, far side over near side: 1 for reflection.
+    /// Radiance is scaled by `1 / eta^2` in `f`; Russian roulette undoes that scale (see
+    /// [`crate::PathIntegrator`]).
+    pub eta: f32,
 }
 
 impl Material {
@@ -221,6 +225,7 @@ impl Material {
                     f: reflectance * FRAC_1_PI,
                     pdf,
                     specular: false,
+                    eta: 1.0,
                 })
             }
             Material::Mirror { reflectance } => Some(BsdfSample {
@@ -228,6 +233,7 @@ impl Material {
                 f: reflectance / wo.z.abs(),
                 pdf: 1.0,
                 specular: true,
+                eta: 1.0,
             }),
             Material::Dielectric { ior } => sample_dielectric(ior, wo, u),
             Material::RoughConductor {
@@ -241,6 +247,7 @@ impl Material {
                         f: schlick(reflectance, wo.z.abs()) / wo.z.abs(),
                         pdf: 1.0,
                         specular: true,
+                        eta: 1.0,
                     });
                 }
                 let flip = wo.z < 0.0;
@@ -261,6 +268,7 @@ impl Material {
                     f,
                     pdf,
                     specular: false,
+                    eta: 1.0,
                 })
             }
         }
@@ -325,6 +333,7 @@ fn sample_dielectric(ior: f32, wo: Vec3, u: f32) -> Option<BsdfSample> {
             f: Vec3::splat(fresnel / cos_o),
             pdf: fresnel,
             specular: true,
+            eta: 1.0,
         });
     }
     // Refraction: eta is the ratio of the index on the far side to the near side.
@@ -343,6 +352,7 @@ fn sample_dielectric(ior: f32, wo: Vec3, u: f32) -> Option<BsdfSample> {
         f: Vec3::splat(transmit / (eta * eta) / cos_t),
         pdf: transmit,
         specular: true,
+        eta,
     })
 }
 

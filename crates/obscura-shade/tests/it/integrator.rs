@@ -590,3 +590,49 @@ fn white_furnace_glass_and_mirror_spheres() {
         "mirror sphere",
     );
 }
+
+#[test]
+fn roulette_sees_through_the_radiance_scaling_of_glass() {
+    // In a uniform environment a lossless glass sphere's paths carry exactly radiance 1 whatever
+    // they do: Fresnel's choice is sampled with its own probability, and the 1 / eta^2 of
+    // entering cancels the eta^2 of leaving. Russian roulette on beta alone would end paths
+    // inside (beta = 1 / 2.25 there) and weight the survivors by 1 / 0.44, so single paths
+    // would carry 0 or 2.25; on beta * eta^2 it never fires, and every path is 1 to rounding.
+    let scene = build(
+        vec![(
+            Shape::Sphere {
+                center: Vec3::ZERO,
+                radius: 1.0,
+            },
+            fixed(),
+            Material::Dielectric { ior: 1.5 },
+            Vec3::ZERO,
+        )],
+        vec![Light::Environment(
+            EnvironmentLight::constant(Vec3::ONE).unwrap(),
+        )],
+    );
+    let integrator = PathIntegrator::new(1000);
+    let mut rng = Rng::new(5);
+    for k in 0..8u64 {
+        let origin = rng.direction() * 4.0;
+        let r = ray(origin, rng.direction() * 0.3 - origin, 0.0);
+        let mut dims = Rng::new(100 + k);
+        for i in 0..500 {
+            let l = integrator.li(&scene.0, &scene.1, &r, &mut dims);
+            assert!((l.x - 1.0).abs() < 1e-3, "direction {k}, path {i}: {l}");
+        }
+    }
+}
+
+#[test]
+fn roulette_survival_hand_values() {
+    use obscura_shade::rr_survival;
+    // The largest channel of beta * eta_scale, clamped to [0.05, 1].
+    assert_eq!(rr_survival(Vec3::new(0.2, 0.4, 0.1), 1.0), 0.4);
+    assert!((rr_survival(Vec3::splat(0.4), 2.25) - 0.9).abs() < 1e-6);
+    assert_eq!(rr_survival(Vec3::splat(0.5), 2.25), 1.0);
+    assert_eq!(rr_survival(Vec3::splat(0.001), 1.0), 0.05);
+    assert_eq!(rr_survival(Vec3::splat(f32::NAN), 1.0), 0.05);
+    assert_eq!(rr_survival(Vec3::splat(f32::INFINITY), 1.0), 1.0);
+}
