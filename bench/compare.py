@@ -5,6 +5,7 @@ Run by hand from the repository root after `bash bench/setup.sh`:
 
     python3 bench/compare.py                 # everything (about 10 minutes on 2 cores)
     python3 bench/compare.py --only accel    # BVH only; --only render for the renders
+    python3 bench/compare.py --only error    # time to equal error (bench/equal_error.py)
 
 It builds the release `obscura` binary and the `obscura-side` example (CARGO_TARGET_DIR is
 honoured), then in this one invocation on this one machine:
@@ -114,10 +115,9 @@ def mitsuba_scene_dict(mi):
         "type": "scene",
         # Obscura's max_depth counts bounces after the camera ray; Mitsuba's counts path
         # vertices including the emitter, so it is one more for the same paths. Both count
-        # bounces alike for Russian roulette, which Obscura starts after three
-        # (PathIntegrator::RR_START_DEPTH) and Mitsuba after rr_depth (default 5): the same
-        # start, so neither traces bounces the other ends (before round 8 Mitsuba did, and
-        # took 2.5% (scalar) to 8% (llvm) longer for it).
+        # bounces alike for Russian roulette, which Obscura starts after
+        # PathIntegrator::RR_START_DEPTH bounces and Mitsuba after rr_depth (default 5): the
+        # same start, so neither traces bounces the other ends.
         "integrator": {
             "type": "path",
             "max_depth": RENDER["max_depth"] + 1,
@@ -406,7 +406,7 @@ def main():
     if len(sys.argv) > 3 and sys.argv[1] == "--mitsuba-worker":
         return mitsuba_worker(sys.argv[2], int(sys.argv[3]))
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--only", choices=["accel", "render", "scaling"])
+    parser.add_argument("--only", choices=["accel", "render", "scaling", "error"])
     parser.add_argument("--no-build", action="store_true", help="use the binaries as built")
     args = parser.parse_args()
     SCRATCH.mkdir(parents=True, exist_ok=True)
@@ -437,6 +437,12 @@ def main():
         results.setdefault("accel", [])
         machines["scaling"] = machine
         bench_scaling(results)
+    if args.only in (None, "error"):
+        # Time to equal error on the comparison scenes (bench/equal_error.py).
+        import equal_error
+
+        machines["error"] = machine
+        results["error"] = equal_error.run(list(equal_error.SCENES), [16, 64, 256], 2)
     saved.write_text(json.dumps(results, indent=2))
 
 
