@@ -289,7 +289,8 @@ impl SceneBuilder {
         let bounds = item_bounds.iter().fold(Bounds3::EMPTY, |a, b| a.union(*b));
 
         // The top level: none for a single item (one mesh, the common benchmark), one SIMD
-        // test of up to eight boxes for a few, obvhs's tree for more.
+        // test of up to eight boxes for a few, two for up to sixteen spheres and quads (a
+        // tree over them costs more: docs/performance.md), obvhs's tree for more.
         let aabbs = item_bounds
             .iter()
             .map(|b| {
@@ -307,6 +308,12 @@ impl SceneBuilder {
         } else if let Some(set) = BoxSet::new(&aabbs) {
             let sorted = items.iter().any(|i| !matches!(i, Item::Analytic { .. }));
             Top::Few { set, sorted }
+        } else if let (Some(lo), Some(hi), true) = (
+            BoxSet::new(&aabbs[..BoxSet::CAPACITY]),
+            BoxSet::new(&aabbs[BoxSet::CAPACITY..]),
+            items.iter().all(|i| matches!(i, Item::Analytic { .. })),
+        ) {
+            Top::Two([lo, hi])
         } else {
             let bvh = build_cwbvh(
                 &aabbs,

@@ -46,6 +46,9 @@ enum Top {
     /// far prunes); otherwise in index order, which for a few spheres and quads costs less
     /// than the sort.
     Few { set: BoxSet, sorted: bool },
+    /// Nine to sixteen spheres and quads (a Cornell box and its contents): two sets of boxes,
+    /// items `0..8` and `8..`, visited in index order like `Few { sorted: false }`.
+    Two([BoxSet; 2]),
     /// obvhs's tree over the items, with its slot -> item map.
     Tree(CwBvh, Vec<u32>),
 }

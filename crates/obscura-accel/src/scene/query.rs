@@ -163,6 +163,25 @@ impl Scene {
                 }
                 best
             }
+            Top::Two(sets) => {
+                let mut best: Option<Found> = None;
+                let mut t_best = r.t_max;
+                for (base, set) in [0, BoxSet::CAPACITY].into_iter().zip(sets) {
+                    let (t_near, mut mask) = set.test(r.o, r.d, r.t_min, t_best);
+                    while mask != 0 {
+                        let lane = mask.trailing_zeros() as usize;
+                        mask &= mask - 1;
+                        if t_near[lane] > t_best {
+                            continue;
+                        }
+                        if let Some(f) = self.intersect_item(base + lane, r, t_best) {
+                            t_best = f.t();
+                            best = Some(f);
+                        }
+                    }
+                }
+                best
+            }
             Top::Tree(tlas, order) => {
                 let top = obvhs::ray::Ray::new(r.o, r.d, r.t_min, r.t_max);
                 let mut ray_hit = RayHit::none();
@@ -202,6 +221,20 @@ impl Scene {
                 }
                 false
             }
+            Top::Two(sets) => [0, BoxSet::CAPACITY]
+                .into_iter()
+                .zip(sets)
+                .any(|(base, set)| {
+                    let mut mask = set.entered_mask(r.o, r.d, r.t_min, r.t_max);
+                    while mask != 0 {
+                        let lane = mask.trailing_zeros() as usize;
+                        mask &= mask - 1;
+                        if self.occluded_item(base + lane, &r) {
+                            return true;
+                        }
+                    }
+                    false
+                }),
             Top::Tree(tlas, order) => {
                 let top = obvhs::ray::Ray::new(r.o, r.d, r.t_min, r.t_max);
                 !tlas.ray_traverse_miss(top, |_, slot| {
