@@ -185,6 +185,24 @@ pub fn decode_exr(bytes: &[u8], path: &Path) -> Result<(Image, bool), RenderErro
                 ),
             });
         }
+        // The reader sizes each chunk's buffer by the declared tile before reading it, so a
+        // tile far larger than the image costs gigabytes even when the file is a few bytes.
+        // A tile as large as the image (or 256 x 256, for small images) is all a file needs.
+        if let exr::meta::BlockDescription::Tiles(tiles) = &header.blocks {
+            let tile = tiles.tile_size;
+            if tile.width() as u64 * tile.height() as u64 > pixels.max(1 << 16) {
+                return Err(RenderError::Encode {
+                    file: path.to_path_buf(),
+                    message: format!(
+                        "cannot read EXR: its header declares tiles of {} x {} pixels, larger than its {} x {} image",
+                        tile.width(),
+                        tile.height(),
+                        size.width(),
+                        size.height()
+                    ),
+                });
+            }
+        }
     }
     let img = read()
         .no_deep_data()
