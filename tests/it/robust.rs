@@ -564,3 +564,58 @@ proptest! {
         prop_assert!(parse_and_build(&text).is_ok(), "panicked on {text:?}");
     }
 }
+
+#[test]
+fn overflowing_camera_arithmetic_gives_no_ray_not_a_nan_ray() {
+    // Found by the camera fuzz target: an orthographic thin lens with a screen window up to
+    // 1.9e34 and a film position of 4.5e30 overflowed to a NaN origin and a zero direction.
+    use obscura_camera::{Camera, CameraSample};
+    use obscura_space::Point2;
+    let text = r#"[film]
+resolution = [110, 110]
+[camera]
+type = "orthographic"
+screen_window = [-5.148387e-17, 4.5925147e27, 4.5925147e27, 1.8588872e34]
+lens_radius = 7.2064745e31
+focal_distance = 1.1561e-41
+eye = [-7.943588e-11, -7.943633e-11, -7.943633e-11]
+target = [-7.943633e-11, -7.943633e-11, -7.943633e-11]
+shutter = [4.597445e27, 4.669886e27]
+near = 4.5925147e27
+"#;
+    let d = obscura_render::parse_description(Path::new("fuzz.toml"), text).unwrap();
+    let camera = obscura_render::camera_of(&d).unwrap();
+    let traceable = |o: [f32; 3], d: [f32; 3]| {
+        o.iter().chain(&d).all(|v| v.is_finite()) && d.iter().any(|&v| v != 0.0)
+    };
+    let coords = [0.5f32, 55.0, 109.5, 1e6, 1.3417982e28, 4.5238512e30, -1e30];
+    for &x in &coords {
+        for &y in &coords {
+            let mut sample = CameraSample::at(Point2::new(x, y));
+            sample.p_lens = glam::Vec2::new(0.3, 0.8);
+            if let Some(r) = camera.generate_ray(&sample) {
+                let (o, dir) = (r.ray.origin, r.ray.direction);
+                assert!(
+                    traceable([o.x, o.y, o.z], [dir.x, dir.y, dir.z]),
+                    "({x}, {y}): {r:?}"
+                );
+            }
+            if let Some(r) = camera.generate_ray_differential(&sample) {
+                for (o, dir) in [
+                    (r.ray.origin, r.ray.direction),
+                    (r.rx_origin, r.rx_direction),
+                    (r.ry_origin, r.ry_direction),
+                ] {
+                    assert!(
+                        traceable([o.x, o.y, o.z], [dir.x, dir.y, dir.z]),
+                        "({x}, {y}): {r:?}"
+                    );
+                }
+            }
+        }
+    }
+    // The fuzzer's own sample gives no ray now.
+    let mut sample = CameraSample::at(Point2::new(4.5238512e30, 1.3417982e28));
+    sample.p_lens = glam::Vec2::ZERO;
+    assert!(camera.generate_ray(&sample).is_none());
+}
