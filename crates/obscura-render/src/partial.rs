@@ -229,14 +229,18 @@ impl Partial {
         }
         check_length_and_checksum(bytes, HEADER_BYTES, bounds).map_err(bad)?;
         // The checksum holds: what follows catches files written by a faulty writer.
-        let name = name.split(|&b| b == 0).next().unwrap_or_default();
+        // The name and zeros after it, exactly as written: bytes after the name's end would
+        // not survive a rewrite (found by the partial fuzz target).
         let integrator = INTEGRATORS
             .into_iter()
-            .find(|k| k.name().as_bytes() == name)
+            .find(|k| {
+                let n = k.name().as_bytes();
+                name.get(..n.len()) == Some(n) && name[n.len()..].iter().all(|&b| b == 0)
+            })
             .ok_or_else(|| {
                 bad(format!(
                     "corrupt: unknown integrator `{}`",
-                    String::from_utf8_lossy(name)
+                    String::from_utf8_lossy(&name).trim_end_matches('\0')
                 ))
             })?;
         let by = match by {
@@ -476,6 +480,23 @@ mod tests {
         assert_eq!(bytes[72..76], 0u32.to_le_bytes());
         assert_eq!(bytes[76..80], 1u32.to_le_bytes());
         assert_eq!(bytes[80..84], 4u32.to_le_bytes());
+    }
+
+    #[test]
+    fn bytes_after_the_integrators_name_are_refused_even_under_a_valid_checksum() {
+        // Found by the partial fuzz target (which reseals its inputs): "depth" followed by a
+        // non-zero padding byte parsed as depth and wrote back with zeros.
+        let bytes = sample_partial(0, 2, 1).to_bytes();
+        for at in 32 + 5..48 {
+            let mut body = bytes[..bytes.len() - 8].to_vec();
+            body[at] = 28;
+            crate::checkpoint::seal(&mut body);
+            let e = Partial::from_bytes(&body, Path::new("p.part")).unwrap_err();
+            assert!(e.to_string().contains("unknown integrator `depth"), "{e}");
+        }
+        // The untouched bytes still parse and write back to themselves.
+        let p = Partial::from_bytes(&bytes, Path::new("p.part")).unwrap();
+        assert_eq!(p.to_bytes(), bytes);
     }
 
     #[test]
