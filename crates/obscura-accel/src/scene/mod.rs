@@ -36,8 +36,10 @@ pub struct Scene {
     uv: bool,
 }
 
-/// The top level of a [`Scene`].
+/// The top level of a [`Scene`]. One per scene, so its size does not matter; boxing the
+/// larger variants would add a pointer chase to every ray.
 #[derive(Debug)]
+#[allow(clippy::large_enum_variant)]
 enum Top {
     /// Zero or one item: no top level.
     One,
