@@ -559,34 +559,27 @@ fn shading_scene_rejects_bad_input_with_clear_messages() {
     assert_eq!(ok.light_select_pdf(), 0.5);
 }
 
+/// A non-emitting sphere of radius 1 at the origin.
+fn unit_sphere(material: Material) -> (Shape, Placement, Material, Vec3) {
+    let sphere = Shape::Sphere {
+        center: Vec3::ZERO,
+        radius: 1.0,
+    };
+    (sphere, fixed(), material, Vec3::ZERO)
+}
+
 #[test]
 fn white_furnace_glass_and_mirror_spheres() {
     // Lossless delta BSDFs alone: glass (paths bounce inside, with total internal reflection)
     // and a mirror of reflectance 1 must vanish into a uniform environment too.
     furnace(
-        vec![(
-            Shape::Sphere {
-                center: Vec3::ZERO,
-                radius: 1.0,
-            },
-            fixed(),
-            Material::Dielectric { ior: 1.5 },
-            Vec3::ZERO,
-        )],
+        vec![unit_sphere(Material::Dielectric { ior: 1.5 })],
         "glass sphere",
     );
     furnace(
-        vec![(
-            Shape::Sphere {
-                center: Vec3::ZERO,
-                radius: 1.0,
-            },
-            fixed(),
-            Material::Mirror {
-                reflectance: Vec3::ONE,
-            },
-            Vec3::ZERO,
-        )],
+        vec![unit_sphere(Material::Mirror {
+            reflectance: Vec3::ONE,
+        })],
         "mirror sphere",
     );
 }
@@ -599,15 +592,7 @@ fn roulette_sees_through_the_radiance_scaling_of_glass() {
     // inside (beta = 1 / 2.25 there) and weight the survivors by 1 / 0.44, so single paths
     // would carry 0 or 2.25; on beta * eta^2 it never fires, and every path is 1 to rounding.
     let scene = build(
-        vec![(
-            Shape::Sphere {
-                center: Vec3::ZERO,
-                radius: 1.0,
-            },
-            fixed(),
-            Material::Dielectric { ior: 1.5 },
-            Vec3::ZERO,
-        )],
+        vec![unit_sphere(Material::Dielectric { ior: 1.5 })],
         vec![Light::Environment(
             EnvironmentLight::constant(Vec3::ONE).unwrap(),
         )],
