@@ -618,4 +618,32 @@ near = 4.5925147e27
     let mut sample = CameraSample::at(Point2::new(4.5238512e30, 1.3417982e28));
     sample.p_lens = glam::Vec2::ZERO;
     assert!(camera.generate_ray(&sample).is_none());
+
+    // The second find: a thin lens at the scale of 1e-22, where squaring a direction's
+    // components underflows and its normalisation came out 1.0075 long.
+    let text = r#"[film]
+resolution = [1, 66]
+[camera]
+type = "perspective"
+fov = 1.2830058e-22
+lens_radius = 1.2830058e-22
+focal_distance = 1.2830058e-22
+lens_shift = [1.2830058e-22, 1.2830058e-22]
+eye = [2.3509887e-38, 0e0, 1.0753431e-22]
+target = [1.2830058e-22, 1.2830058e-22, 1.2830058e-22]
+near = 1.2830058e-22
+"#;
+    let d = obscura_render::parse_description(Path::new("fuzz.toml"), text).unwrap();
+    let camera = obscura_render::camera_of(&d).unwrap();
+    for y in [0.5f32, 33.0, 65.5] {
+        for lens in [glam::Vec2::new(0.1, 0.9), glam::Vec2::new(0.7, 0.2)] {
+            let mut sample = CameraSample::at(Point2::new(0.5, y));
+            sample.p_lens = lens;
+            if let Some(r) = camera.generate_ray(&sample) {
+                let dir = r.ray.direction;
+                let len = (dir.x * dir.x + dir.y * dir.y + dir.z * dir.z).sqrt();
+                assert!((len - 1.0).abs() < 1e-3, "({y}, {lens}): length {len}");
+            }
+        }
+    }
 }

@@ -66,8 +66,9 @@ macro_rules! dispatch {
 
 impl Camera for AnyCamera {
     // Every model's ray passes one check here: under extreme parameters (found by the camera
-    // fuzz target: an orthographic screen window of 1e34 and a film position of 1e30) a
-    // model's arithmetic can overflow to a NaN origin or a zero direction.
+    // fuzz target: an orthographic screen window of 1e34 and a film position of 1e30; a thin
+    // lens whose radius and focal distance are 1e-22, where squaring underflows) a model's
+    // arithmetic can give a NaN origin or a direction that is not unit length.
     #[inline]
     fn generate_ray(&self, sample: &CameraSample) -> Option<CameraRay> {
         dispatch!(self, c => c.generate_ray(sample))

@@ -90,12 +90,12 @@ pub struct CameraRayDifferential {
     pub weight: f32,
 }
 
-/// True when `origin` is finite and `direction` finite and non-zero: a ray a renderer can
-/// trace.
+/// True when `origin` is finite and `direction` a unit vector to 1e-3: a ray a renderer can
+/// trace (a NaN direction fails the comparison too).
 #[inline]
 pub(crate) fn traceable(origin: Point3<World>, direction: Vector3<World>) -> bool {
     let (o, d) = (origin.to_glam(), direction.to_glam());
-    o.is_finite() && d.is_finite() && d != glam::Vec3::ZERO
+    o.is_finite() && (d.length_squared() - 1.0).abs() <= 1e-3
 }
 
 /// A camera model: rays from samples, and the inverse, world points to raster positions.
@@ -103,8 +103,9 @@ pub trait Camera: Send + Sync {
     /// The world-space ray of a sample, at time `shutter().time_at(sample.time)`, with a unit
     /// direction and `[t_min, t_max]` set to the camera's clip range. `None` when the sample
     /// gives no ray (a non-finite film position). Through [`AnyCamera`](crate::AnyCamera),
-    /// also `None` when the numbers overflow (a film position far outside the image under
-    /// extreme parameters): its rays always have finite origins and non-zero finite directions.
+    /// also `None` when the numbers overflow or underflow (a film position far outside the
+    /// image, or lens and focus sizes near 1e-22): its rays always have finite origins and
+    /// unit directions.
     fn generate_ray(&self, sample: &CameraSample) -> Option<CameraRay>;
 
     /// [`Camera::generate_ray`] plus the rays one pixel right and one pixel down, with the same
