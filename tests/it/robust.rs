@@ -646,4 +646,37 @@ near = 1.2830058e-22
             }
         }
     }
+
+    // The third: a cylindrical camera of fov 1e-45 degrees projected a point to (1, inf).
+    let text = r#"[film]
+resolution = [1, 1]
+[camera]
+type = "cylindrical"
+fov = 1e-45
+eye = [-3.0517578e-5, -3.5424324e-4, -3.5424324e-4]
+target = [2.1540213e8, 2.153771e8, 2.4712324e-33]
+near = 1.6495023e-33
+"#;
+    let d = obscura_render::parse_description(Path::new("fuzz.toml"), text).unwrap();
+    let camera = obscura_render::camera_of(&d).unwrap();
+    for x in [0.1f32, 0.5, 0.9] {
+        for y in [0.1f32, 0.5, 0.9] {
+            let Some(r) = camera.generate_ray(&CameraSample::at(Point2::new(x, y))) else {
+                continue;
+            };
+            for t in [1e-3f32, 1.0, 1e3] {
+                let p = r.ray.origin + r.ray.direction * t;
+                if let Some(q) = camera.project(p, 0.0) {
+                    assert!(
+                        q.x.is_finite() && q.y.is_finite(),
+                        "({x}, {y}) at {t}: {q:?}"
+                    );
+                }
+            }
+            let off = r.ray.origin + obscura_space::Vector3::new(1.0, 1.0, 1.0);
+            if let Some(q) = camera.project(off, 0.0) {
+                assert!(q.x.is_finite() && q.y.is_finite(), "off the ray: {q:?}");
+            }
+        }
+    }
 }

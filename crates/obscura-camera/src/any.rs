@@ -82,9 +82,11 @@ impl Camera for AnyCamera {
                 && traceable(r.ry_origin, r.ry_direction)
         })
     }
+    // As for rays: a projection that overflowed (a cylindrical camera of fov 1e-45 degrees,
+    // found by the camera fuzz target) is None, not infinite.
     #[inline]
     fn project(&self, p: Point3<World>, time: f32) -> Option<Point2<Raster>> {
-        dispatch!(self, c => c.project(p, time))
+        dispatch!(self, c => c.project(p, time)).filter(|q| q.x.is_finite() && q.y.is_finite())
     }
     #[inline]
     fn base(&self) -> &CameraBase {
