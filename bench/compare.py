@@ -158,13 +158,9 @@ def mitsuba_scene_dict(mi):
 
 def mitsuba_worker(variant, threads):
     pin(threads)
-    if "DRJIT_LIBLLVM_PATH" not in os.environ:
-        # Debian names it libLLVM-19.so; drjit looks for libLLVM.so by default.
-        found = sorted(Path("/usr/lib").glob("*/libLLVM-1[5-9]*.so*")) + sorted(
-            Path("/usr/lib").glob("*/libLLVM.so.*")
-        )
-        if found:
-            os.environ["DRJIT_LIBLLVM_PATH"] = str(found[-1])
+    import equal_error
+
+    equal_error.set_llvm_path()
     import drjit as dr
     import mitsuba as mi
 

@@ -228,7 +228,9 @@ def mitsuba_worker(variant, xml, spp, seeds, params, out, threads):
 
 
 def mitsuba_render(variant, xml, spp, seeds, params, threads):
-    out = xml.with_name(f"mi-{variant}-{spp}-{abs(hash(json.dumps(params))) % 10**8}.npy")
+    # A stable name per configuration (Python's own hash of a string changes per process).
+    key = hashlib.sha256(json.dumps(params, sort_keys=True).encode()).hexdigest()[:8]
+    out = xml.with_name(f"mi-{variant}-{spp}-{key}.npy")
     run = subprocess.run(
         [sys.executable, __file__, "--mitsuba-worker", variant, str(xml), str(spp),
          json.dumps(list(seeds)), json.dumps(params), str(out), str(threads)],
