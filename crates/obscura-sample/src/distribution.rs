@@ -6,10 +6,19 @@ use glam::Vec2;
 
 /// A piecewise-constant density over `[0, 1)` with `n` equal bins of non-negative weights.
 /// When every weight is zero it falls back to the uniform density (so sampling never fails).
+///
+/// Sampling inverts the CDF with a guide table (the cutpoint method, Chen and Asau 1974):
+/// `n` buckets of `u`, each knowing which CDF entries can answer for it, so a search looks at
+/// about two entries instead of binary-searching all `n + 1`. The answer is exactly the full
+/// binary search's.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Distribution1D {
-    func: Vec<f32>,
-    cdf: Vec<f32>,
+    /// `n + 1` cells: the CDF at each bin's start beside the bin's weight (0 in the last), so
+    /// the search that finds a bin has also loaded its density.
+    cells: Vec<Cell>,
+    /// `guide[k]` = how many CDF entries fall in buckets below `k` (see [`Distribution1D::bucket`]);
+    /// `n + 1` entries.
+    guide: Vec<u32>,
     integral: f32,
 }
 
@@ -44,16 +53,22 @@ impl Distribution1D {
             }
         }
         cdf[n] = 1.0;
+        let guide = guide_table(&cdf, n);
+        let cells = cdf
+            .iter()
+            .zip(func.iter().chain([&0.0]))
+            .map(|(&cdf, &func)| Cell { cdf, func })
+            .collect();
         Distribution1D {
-            func,
-            cdf,
+            cells,
+            guide,
             integral,
         }
     }
 
     /// The number of bins.
     pub fn len(&self) -> usize {
-        self.func.len()
+        self.cells.len() - 1
     }
 
     /// Always false: there is at least one bin.
@@ -74,7 +89,7 @@ impl Distribution1D {
     /// The density at `x` in `[0, 1)` with respect to `x`.
     pub fn pdf(&self, x: f32) -> f32 {
         if self.integral > 0.0 {
-            self.func[self.bin(x)] / self.integral
+            self.cells[self.bin(x)].func / self.integral
         } else {
             1.0
         }
@@ -82,17 +97,19 @@ impl Distribution1D {
 
     /// The probability of bin `i` (its share of the total weight).
     pub fn discrete_pdf(&self, i: usize) -> f32 {
-        match self.func.get(i) {
-            Some(&f) if self.integral > 0.0 => f / (self.integral * self.len() as f32),
-            Some(_) => 1.0 / self.len() as f32,
-            None => 0.0,
+        if i >= self.len() {
+            0.0
+        } else if self.integral > 0.0 {
+            self.cells[i].func / (self.integral * self.len() as f32)
+        } else {
+            1.0 / self.len() as f32
         }
     }
 
     /// Inverts the CDF: returns `(x, pdf(x), bin)` for a canonical `u` in `[0, 1)`.
     pub fn sample_continuous(&self, u: f32) -> (f32, f32, usize) {
         let i = self.find(u);
-        let (c0, c1) = (self.cdf[i], self.cdf[i + 1]);
+        let (c0, c1) = (self.cells[i].cdf, self.cells[i + 1].cdf);
         let du = if c1 > c0 { (u - c0) / (c1 - c0) } else { 0.5 };
         let x = ((i as f32 + du.clamp(0.0, 1.0)) / self.len() as f32).min(ONE_MINUS_EPSILON);
         (x, self.pdf(x), i)
@@ -102,7 +119,7 @@ impl Distribution1D {
     /// probability and `u` re-stretched to `[0, 1)` within the bin (reusable as a fresh number).
     pub fn sample_discrete(&self, u: f32) -> (usize, f32, f32) {
         let i = self.find(u);
-        let (c0, c1) = (self.cdf[i], self.cdf[i + 1]);
+        let (c0, c1) = (self.cells[i].cdf, self.cells[i + 1].cdf);
         let u_remapped = if c1 > c0 {
             ((u - c0) / (c1 - c0)).clamp(0.0, ONE_MINUS_EPSILON)
         } else {
@@ -111,18 +128,54 @@ impl Distribution1D {
         (i, self.discrete_pdf(i), u_remapped)
     }
 
+    /// The guide bucket of `u`: `floor(u n)`, clamped to `0..n`. Monotone in `u`, which is all
+    /// the guide table relies on.
+    fn bucket(u: f32, n: usize) -> usize {
+        ((u * n as f32) as usize).min(n - 1)
+    }
+
+    /// The number of CDF entries `<= u`, i.e. `cdf.partition_point(|&c| c <= u)`, searched
+    /// only among the entries of `u`'s bucket. Every entry in a lower bucket is below `u` and
+    /// every entry in a higher one above it (the bucket is monotone), so the count lies
+    /// between `guide[k]` and `guide[k + 1]`.
+    fn count_at_or_below(&self, u: f32) -> usize {
+        let k = Self::bucket(u, self.len());
+        let (lo, hi) = (self.guide[k] as usize, self.guide[k + 1] as usize);
+        lo + self.cells[lo..hi].partition_point(|c| c.cdf <= u)
+    }
+
     /// The last bin `i` with `cdf[i] <= u`, skipping empty bins.
     fn find(&self, u: f32) -> usize {
         let n = self.len();
-        // partition_point: first index with cdf > u; the bin is one before it.
-        let first_above = self.cdf.partition_point(|&c| c <= u);
+        // The first index with cdf > u; the bin is one before it.
+        let first_above = self.count_at_or_below(u);
         let mut i = first_above.saturating_sub(1).min(n - 1);
         // Never land in a zero-weight bin through rounding at the CDF's flat parts.
-        while i + 1 < n && self.cdf[i + 1] <= self.cdf[i] {
+        while i + 1 < n && self.cells[i + 1].cdf <= self.cells[i].cdf {
             i += 1;
         }
         i
     }
+}
+
+/// One bin of a [`Distribution1D`]: the CDF where it starts and its weight.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Cell {
+    cdf: f32,
+    func: f32,
+}
+
+/// The guide table of a sorted CDF of `n + 1` entries over `n` buckets: entry `k` counts the
+/// CDF entries whose bucket is below `k`, so entry `n` counts them all.
+fn guide_table(cdf: &[f32], n: usize) -> Vec<u32> {
+    let mut guide = vec![0u32; n + 1];
+    for &c in cdf {
+        guide[Distribution1D::bucket(c, n) + 1] += 1;
+    }
+    for k in 1..=n {
+        guide[k] += guide[k - 1];
+    }
+    guide
 }
 
 /// A piecewise-constant density over `[0, 1)^2` on a `width x height` grid: a marginal
@@ -198,6 +251,29 @@ mod tests {
 
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(300))]
+        #[test]
+        fn guided_search_equals_the_full_binary_search(
+            weights in proptest::collection::vec(
+                prop_oneof![Just(0.0f32), 0.0f32..1.0, 1e3f32..1e6], 1..300),
+            us in proptest::collection::vec(
+                prop_oneof![0.0f32..1.0, Just(0.0f32), Just(ONE_MINUS_EPSILON), -1.0f32..2.0], 32),
+            picks in proptest::collection::vec(0usize..1000, 16),
+        ) {
+            let d = Distribution1D::new(&weights);
+            let cdf: Vec<f32> = d.cells.iter().map(|c| c.cdf).collect();
+            // Random u, and u exactly on CDF entries and one ulp either side of them, where a
+            // bucket boundary and a CDF step can meet.
+            let mut probes = us.clone();
+            for p in picks {
+                let c = cdf[p % cdf.len()];
+                probes.extend([c, f32::from_bits(c.to_bits().saturating_sub(1)), f32::from_bits(c.to_bits() + 1)]);
+            }
+            probes.push(f32::NAN);
+            for u in probes {
+                prop_assert_eq!(d.count_at_or_below(u), cdf.partition_point(|&c| c <= u), "u = {}", u);
+            }
+        }
+
         #[test]
         fn sampled_pdf_matches_evaluated_pdf(
             weights in proptest::collection::vec(0.0f32..10.0, 1..6),
