@@ -277,11 +277,11 @@ impl PathIntegrator {
                     let Light::Environment(env) = &shading.lights[i as usize] else {
                         continue;
                     };
-                    let le = env.radiance(d_world);
-                    let weight = if specular_bounce {
-                        1.0
+                    let (le, weight) = if specular_bounce {
+                        (env.radiance(d_world), 1.0)
                     } else {
-                        power_heuristic(prev_pdf, light_select * env.pdf_li(d_world))
+                        let (le, pdf) = env.radiance_and_pdf(d_world);
+                        (le, power_heuristic(prev_pdf, light_select * pdf))
                     };
                     radiance += beta * le * weight;
                 }

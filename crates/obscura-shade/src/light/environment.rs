@@ -143,18 +143,26 @@ impl EnvironmentLight {
 
     /// The solid-angle density with which [`EnvironmentLight::sample_li`] returns `d_world`.
     pub fn pdf_li(&self, d_world: Vec3) -> f32 {
+        self.radiance_and_pdf(d_world).1
+    }
+
+    /// [`EnvironmentLight::radiance`] and [`EnvironmentLight::pdf_li`] of one direction, with
+    /// the direction's map coordinates found once (what a path that escapes needs).
+    pub fn radiance_and_pdf(&self, d_world: Vec3) -> (Vec3, f32) {
         match &self.kind {
-            EnvironmentKind::Constant(_) => uniform_sphere_pdf(),
+            EnvironmentKind::Constant(l) => (*l, uniform_sphere_pdf()),
             EnvironmentKind::Map(map) => {
                 let d_light = map.light_from_world * d_world;
                 let uv = direction_to_uv(d_light);
                 // sin(theta) from the direction itself: well conditioned at the poles, where
                 // going through acos would lose most digits.
                 let sin_theta = Vec2::new(d_light.x, d_light.z).length() / d_light.length();
-                if sin_theta <= TINY {
-                    return 0.0;
-                }
-                map.distribution.pdf(uv) / (2.0 * PI * PI * sin_theta)
+                let pdf = if sin_theta <= TINY {
+                    0.0
+                } else {
+                    map.distribution.pdf(uv) / (2.0 * PI * PI * sin_theta)
+                };
+                (map.texel(uv), pdf)
             }
         }
     }

@@ -42,6 +42,20 @@ proptest! {
             prop_assert!(s.p_light.is_none() && !s.delta);
         }
     }
+
+    #[test]
+    // pdf_li is radiance_and_pdf's second half, checked against sampling above; this checks
+    // the first half against radiance, which finds the texel on its own.
+    fn radiance_and_pdf_sees_what_radiance_sees(
+        x in -1.0f32..1.0, y in -1.0f32..1.0, z in -1.0f32..1.0,
+    ) {
+        let d = Vec3::new(x, y, z);
+        prop_assume!(d.length() > 1e-3);
+        let d = d.normalize();
+        for env in [test_map(), EnvironmentLight::constant(Vec3::new(0.5, 1.0, 2.0)).unwrap()] {
+            prop_assert_eq!(env.radiance_and_pdf(d).0, env.radiance(d));
+        }
+    }
 }
 
 /// A 16 x 8 map with a bright spot, rotated 30 degrees about x.
