@@ -11,21 +11,45 @@ use glam::Vec2;
 /// `n` buckets of `u`, each knowing which CDF entries can answer for it, so a search looks at
 /// about two entries instead of binary-searching all `n + 1`. The answer is exactly the full
 /// binary search's.
+///
+/// Each bin can carry a value `V` (an environment map's texel beside its weight), kept in the
+/// same cell as the bin's CDF entry and weight: finding a bin, its density and its value
+/// touches one place in memory, which is what a large map's sampling waits on.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Distribution1D {
-    /// `n + 1` cells: the CDF at each bin's start beside the bin's weight (0 in the last), so
-    /// the search that finds a bin has also loaded its density.
-    cells: Vec<Cell>,
-    /// `guide[k]` = how many CDF entries fall in buckets below `k` (see [`Distribution1D::bucket`]);
-    /// `n + 1` entries.
-    guide: Vec<u32>,
+pub struct Distribution1D<V = ()> {
+    /// `n + 1` cells: cell `i` holds the CDF where bin `i` starts, the bin's weight (0 in the
+    /// last), guide entry `i` and the bin's value (the default in the last).
+    cells: Vec<Cell<V>>,
     integral: f32,
+}
+
+/// One bin of a [`Distribution1D`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Cell<V> {
+    cdf: f32,
+    func: f32,
+    /// How many CDF entries fall in guide buckets below this cell's index (see
+    /// [`Distribution1D::bucket`]).
+    guide: u32,
+    value: V,
 }
 
 impl Distribution1D {
     /// A distribution over the given bin weights (non-negative and finite; others count as 0).
     /// An empty slice is treated as one bin.
     pub fn new(weights: &[f32]) -> Distribution1D {
+        Distribution1D::build(weights, |_| ())
+    }
+}
+
+impl<V: Copy + Default> Distribution1D<V> {
+    /// A distribution over `weights` (as [`Distribution1D::new`]) whose bin `i` carries
+    /// `values[i]` (the default where `values` is shorter).
+    pub fn with_values(weights: &[f32], values: &[V]) -> Distribution1D<V> {
+        Distribution1D::build(weights, |i| values.get(i).copied().unwrap_or_default())
+    }
+
+    fn build(weights: &[f32], value: impl Fn(usize) -> V) -> Distribution1D<V> {
         let mut func: Vec<f32> = weights
             .iter()
             .map(|&w| if w.is_finite() && w > 0.0 { w } else { 0.0 })
@@ -53,17 +77,23 @@ impl Distribution1D {
             }
         }
         cdf[n] = 1.0;
-        let guide = guide_table(&cdf, n);
-        let cells = cdf
-            .iter()
-            .zip(func.iter().chain([&0.0]))
-            .map(|(&cdf, &func)| Cell { cdf, func })
-            .collect();
-        Distribution1D {
-            cells,
-            guide,
-            integral,
+        // Guide entry k: the CDF entries in buckets below k (a histogram, then running sums).
+        let mut guide = vec![0u32; n + 1];
+        for &c in &cdf {
+            guide[Self::bucket(c, n) + 1] += 1;
         }
+        for k in 1..=n {
+            guide[k] += guide[k - 1];
+        }
+        let cells = (0..=n)
+            .map(|i| Cell {
+                cdf: cdf[i],
+                func: func.get(i).copied().unwrap_or(0.0),
+                guide: guide[i],
+                value: if i < n { value(i) } else { V::default() },
+            })
+            .collect();
+        Distribution1D { cells, integral }
     }
 
     /// The number of bins.
@@ -88,11 +118,23 @@ impl Distribution1D {
 
     /// The density at `x` in `[0, 1)` with respect to `x`.
     pub fn pdf(&self, x: f32) -> f32 {
-        if self.integral > 0.0 {
-            self.cells[self.bin(x)].func / self.integral
+        self.pdf_and_value(x).0
+    }
+
+    /// The value of the bin holding `x` in `[0, 1)` (clamped).
+    pub fn value(&self, x: f32) -> V {
+        self.cells[self.bin(x)].value
+    }
+
+    /// [`Distribution1D::pdf`] and [`Distribution1D::value`] at `x`, from one cell.
+    pub fn pdf_and_value(&self, x: f32) -> (f32, V) {
+        let cell = &self.cells[self.bin(x)];
+        let pdf = if self.integral > 0.0 {
+            cell.func / self.integral
         } else {
             1.0
-        }
+        };
+        (pdf, cell.value)
     }
 
     /// The probability of bin `i` (its share of the total weight).
@@ -135,12 +177,15 @@ impl Distribution1D {
     }
 
     /// The number of CDF entries `<= u`, i.e. `cdf.partition_point(|&c| c <= u)`, searched
-    /// only among the entries of `u`'s bucket. Every entry in a lower bucket is below `u` and
-    /// every entry in a higher one above it (the bucket is monotone), so the count lies
-    /// between `guide[k]` and `guide[k + 1]`.
+    /// only among the entries of `u`'s bucket `k`. Every entry in a lower bucket is below `u`
+    /// and every entry in a higher one above it (the bucket is monotone), so the count lies
+    /// between guide entries `k` and `k + 1`.
     fn count_at_or_below(&self, u: f32) -> usize {
         let k = Self::bucket(u, self.len());
-        let (lo, hi) = (self.guide[k] as usize, self.guide[k + 1] as usize);
+        let (lo, hi) = (
+            self.cells[k].guide as usize,
+            self.cells[k + 1].guide as usize,
+        );
         lo + self.cells[lo..hi].partition_point(|c| c.cdf <= u)
     }
 
@@ -158,42 +203,38 @@ impl Distribution1D {
     }
 }
 
-/// One bin of a [`Distribution1D`]: the CDF where it starts and its weight.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Cell {
-    cdf: f32,
-    func: f32,
-}
-
-/// The guide table of a sorted CDF of `n + 1` entries over `n` buckets: entry `k` counts the
-/// CDF entries whose bucket is below `k`, so entry `n` counts them all.
-fn guide_table(cdf: &[f32], n: usize) -> Vec<u32> {
-    let mut guide = vec![0u32; n + 1];
-    for &c in cdf {
-        guide[Distribution1D::bucket(c, n) + 1] += 1;
-    }
-    for k in 1..=n {
-        guide[k] += guide[k - 1];
-    }
-    guide
-}
-
 /// A piecewise-constant density over `[0, 1)^2` on a `width x height` grid: a marginal
-/// distribution over rows (`v`) and a conditional one over columns (`u`) in each row.
+/// distribution over rows (`v`) and a conditional one over columns (`u`) in each row. Each
+/// grid cell can carry a value `V`, as a [`Distribution1D`]'s bins do.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Distribution2D {
-    conditional: Vec<Distribution1D>,
+pub struct Distribution2D<V = ()> {
+    conditional: Vec<Distribution1D<V>>,
     marginal: Distribution1D,
 }
 
 impl Distribution2D {
     /// From row-major weights (`weights[y * width + x]`); `weights.len()` must be `width * height`.
     pub fn new(weights: &[f32], width: usize, height: usize) -> Distribution2D {
+        Distribution2D::with_values(weights, &[], width, height)
+    }
+}
+
+impl<V: Copy + Default> Distribution2D<V> {
+    /// [`Distribution2D::new`] with grid cell `(x, y)` carrying `values[y * width + x]` (the
+    /// default where `values` is shorter).
+    pub fn with_values(
+        weights: &[f32],
+        values: &[V],
+        width: usize,
+        height: usize,
+    ) -> Distribution2D<V> {
         let width = width.max(1);
-        let conditional: Vec<Distribution1D> = (0..height.max(1))
+        let conditional: Vec<Distribution1D<V>> = (0..height.max(1))
             .map(|y| {
                 let row = weights.get(y * width..(y + 1) * width).unwrap_or(&[]);
-                Distribution1D::new(row)
+                let row_values = values.get(y * width..).unwrap_or(&[]);
+                let row_values = &row_values[..row_values.len().min(width)];
+                Distribution1D::with_values(row, row_values)
             })
             .collect();
         let row_integrals: Vec<f32> = conditional.iter().map(|d| d.integral()).collect();
@@ -211,10 +252,32 @@ impl Distribution2D {
         (Vec2::new(u, v), pdf_u * pdf_v)
     }
 
+    /// [`Distribution2D::sample`] with the value of the grid cell holding the point.
+    pub fn sample_with_value(&self, u2: Vec2) -> (Vec2, f32, V) {
+        let (p, pdf) = self.sample(u2);
+        (p, pdf, self.value(p))
+    }
+
+    /// The row holding `y` in `[0, 1)` (clamped).
+    fn row(&self, y: f32) -> &Distribution1D<V> {
+        let n = self.conditional.len();
+        &self.conditional[((y * n as f32) as usize).min(n - 1)]
+    }
+
     /// The density at `(u, v)` in `[0, 1)^2`.
     pub fn pdf(&self, p: Vec2) -> f32 {
-        let row = ((p.y * self.conditional.len() as f32) as usize).min(self.conditional.len() - 1);
-        self.marginal.pdf(p.y) * self.conditional[row].pdf(p.x)
+        self.pdf_and_value(p).0
+    }
+
+    /// The value of the grid cell holding `p` in `[0, 1)^2` (clamped).
+    pub fn value(&self, p: Vec2) -> V {
+        self.row(p.y).value(p.x)
+    }
+
+    /// [`Distribution2D::pdf`] and [`Distribution2D::value`] at `p`, from one cell of the grid.
+    pub fn pdf_and_value(&self, p: Vec2) -> (f32, V) {
+        let (pdf_u, value) = self.row(p.y).pdf_and_value(p.x);
+        (self.marginal.pdf(p.y) * pdf_u, value)
     }
 }
 
@@ -238,6 +301,17 @@ mod tests {
         assert_eq!(pdf, 1.5);
         // u = 0.5 sits on the flat part of the CDF at bin 2: it must go to bin 3, never bin 2.
         assert_eq!(d.sample_continuous(0.5).2, 3);
+    }
+
+    #[test]
+    fn values_sit_in_their_cells() {
+        // A 3 x 2 grid: the point (0.5, 0.75) is in column 1 of row 1, cell 4; the last
+        // cell's value is missing from the slice and is the default.
+        let d = Distribution2D::with_values(&[1.0; 6], &[10, 11, 12, 13, 14], 3, 2);
+        assert_eq!(d.value(Vec2::new(0.5, 0.75)), 14);
+        assert_eq!(d.value(Vec2::new(0.0, 0.0)), 10);
+        assert_eq!(d.value(Vec2::new(0.99, 0.99)), 0);
+        assert_eq!(d.pdf_and_value(Vec2::new(0.5, 0.25)), (1.0, 11));
     }
 
     #[test]
@@ -288,6 +362,23 @@ mod tests {
             prop_assert!(p.x >= 0.0 && p.x < 1.0 && p.y >= 0.0 && p.y < 1.0);
             prop_assert!(pdf > 0.0);
             prop_assert!((d.pdf(p) - pdf).abs() <= 1e-4 * pdf.max(1.0));
+        }
+
+        #[test]
+        fn a_sample_carries_the_value_of_the_cell_it_lands_in(
+            weights in proptest::collection::vec(
+                prop_oneof![Just(0.0f32), 0.0f32..10.0], 12),
+            ux in 0.0f32..1.0, uy in 0.0f32..1.0,
+        ) {
+            // A 4 x 3 grid whose cells carry their own row-major index.
+            let (w, h) = (4, 3);
+            let values: Vec<u32> = (0..12).collect();
+            let d = Distribution2D::with_values(&weights, &values, w, h);
+            let (p, pdf, value) = d.sample_with_value(Vec2::new(ux, uy));
+            let (x, y) = ((p.x * w as f32) as u32, (p.y * h as f32) as u32);
+            prop_assert_eq!(value, y * w as u32 + x);
+            prop_assert_eq!(d.pdf_and_value(p), (pdf, value));
+            prop_assert_eq!(Distribution2D::new(&weights, w, h).sample(Vec2::new(ux, uy)), (p, pdf));
         }
 
         #[test]

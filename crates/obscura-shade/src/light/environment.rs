@@ -24,10 +24,11 @@ enum EnvironmentKind {
 /// An equirectangular (latitude-longitude) radiance map with its sampling distribution.
 #[derive(Debug, Clone)]
 struct LatLongMap {
-    width: u32,
-    height: u32,
-    texels: Vec<Vec3>,
-    distribution: Distribution2D,
+    /// The texels' sampling density, each cell carrying its texel's radiance: the grid of
+    /// the distribution is the map's, so a texel and its density are one load apart. Lookups
+    /// take the nearest texel, unfiltered: the radiance is piecewise constant exactly like
+    /// the sampling density.
+    distribution: Distribution2D<Vec3>,
     world_from_light: Mat3,
     light_from_world: Mat3,
 }
@@ -89,12 +90,9 @@ impl EnvironmentLight {
                 weights.push(luminance(texels[y * w + x]) * sin_theta);
             }
         }
-        let distribution = Distribution2D::new(&weights, w, h);
+        let distribution = Distribution2D::with_values(&weights, &texels, w, h);
         Ok(EnvironmentLight {
             kind: EnvironmentKind::Map(Box::new(LatLongMap {
-                width,
-                height,
-                texels,
                 distribution,
                 world_from_light: rotation,
                 light_from_world: rotation.transpose(),
@@ -108,7 +106,7 @@ impl EnvironmentLight {
             EnvironmentKind::Constant(l) => *l,
             EnvironmentKind::Map(map) => {
                 let uv = direction_to_uv(map.light_from_world * d_world);
-                map.texel(uv)
+                map.distribution.value(uv)
             }
         }
     }
@@ -124,7 +122,7 @@ impl EnvironmentLight {
                 delta: false,
             }),
             EnvironmentKind::Map(map) => {
-                let (uv, pdf_uv) = map.distribution.sample(u2);
+                let (uv, pdf_uv, radiance) = map.distribution.sample_with_value(u2);
                 let sin_theta = (PI * uv.y).sin();
                 if pdf_uv <= 0.0 || sin_theta <= TINY {
                     return None;
@@ -132,7 +130,7 @@ impl EnvironmentLight {
                 let d_light = uv_to_direction(uv);
                 Some(LightSample {
                     wi: (map.world_from_light * d_light).normalize(),
-                    radiance: map.texel(uv),
+                    radiance,
                     pdf: pdf_uv / (2.0 * PI * PI * sin_theta),
                     p_light: None,
                     delta: false,
@@ -157,24 +155,15 @@ impl EnvironmentLight {
                 // sin(theta) from the direction itself: well conditioned at the poles, where
                 // going through acos would lose most digits.
                 let sin_theta = Vec2::new(d_light.x, d_light.z).length() / d_light.length();
+                let (pdf_uv, radiance) = map.distribution.pdf_and_value(uv);
                 let pdf = if sin_theta <= TINY {
                     0.0
                 } else {
-                    map.distribution.pdf(uv) / (2.0 * PI * PI * sin_theta)
+                    pdf_uv / (2.0 * PI * PI * sin_theta)
                 };
-                (map.texel(uv), pdf)
+                (radiance, pdf)
             }
         }
-    }
-}
-
-impl LatLongMap {
-    /// The texel holding map coordinates `uv` in `[0, 1]^2` (nearest, no filtering: the
-    /// radiance is piecewise constant exactly like the sampling density).
-    fn texel(&self, uv: Vec2) -> Vec3 {
-        let x = ((uv.x * self.width as f32) as u32).min(self.width - 1);
-        let y = ((uv.y * self.height as f32) as u32).min(self.height - 1);
-        self.texels[(y * self.width + x) as usize]
     }
 }
 
