@@ -36,6 +36,8 @@ import sys
 import time
 from pathlib import Path
 
+from equal_error import platform_cpu
+
 ROOT = Path(__file__).resolve().parent.parent
 TARGET = Path(os.environ.get("CARGO_TARGET_DIR", ROOT / "target"))
 SCRATCH = Path(os.environ.get("OBSCURA_BENCH_DIR", "/tmp/obscura-bench"))
@@ -447,29 +449,6 @@ def transparent_huge_pages():
         return Path("/sys/kernel/mm/transparent_hugepage/enabled").read_text().strip()
     except OSError:
         return "unknown"
-
-
-# /proc/cpuinfo's flags of the vector extensions, widest first, with the names printed.
-VECTOR_ISAS = [("avx512f", "AVX-512"), ("avx2", "AVX2"), ("avx", "AVX"), ("sse4_2", "SSE4.2")]
-
-
-def platform_cpu():
-    """The CPU as /proc/cpuinfo names it, with its family and model (a virtual machine's model
-    name may say only "AMD EPYC") and the widest vector instructions it has."""
-    fields = {}
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            key, _, value = line.partition(":")
-            fields.setdefault(key.strip(), value.strip())
-    except OSError:
-        return "unknown CPU"
-    flags = set(fields.get("flags", "").split())
-    isa = next((name for flag, name in VECTOR_ISAS if flag in flags), "SSE2")
-    return (
-        f"{fields.get('model name', 'unknown CPU')} (family {fields.get('cpu family', '?')} "
-        f"model {fields.get('model', '?')}, {isa})"
-    )
-
 
 
 if __name__ == "__main__":

@@ -295,6 +295,8 @@ def run(scenes, spps, threads, seeds_per_spp=2):
               file=sys.stderr)
         configs = [c for c in configs if c[1] != "llvm_ad_rgb"]
     results = []
+    machine = platform_cpu()
+    print(f"machine: {os.cpu_count()} CPUs, {machine}")
     for name in scenes:
         xml = prepare(name)
         ref, ref_mse = reference(name, xml, threads, variant_ref)
@@ -302,7 +304,8 @@ def run(scenes, spps, threads, seeds_per_spp=2):
               f"{variant_ref} 2x{REFERENCE_PASSES * REFERENCE_PASS_SPP} spp, own rel. RMSE "
               f"{ref_mse ** 0.5:.4f}")
         print(f"  {'configuration':<26}{'spp':>6}{'time s':>9}{'rel RMSE':>10}{'efficiency':>12}")
-        scene_result = {"scene": name, "reference_rel_mse": ref_mse, "configs": []}
+        scene_result = {"scene": name, "machine": machine, "reference_rel_mse": ref_mse,
+                        "configs": []}
         for label, sampler in OBSCURA_CONFIGS:
             toml = obscura_scene(xml, sampler)
             points = []
@@ -345,6 +348,28 @@ def run(scenes, spps, threads, seeds_per_spp=2):
             print(f"    {config['label']:<28}{ratio:>7.2f}")
         results.append(scene_result)
     return results
+
+
+# /proc/cpuinfo's flags of the vector extensions, widest first, with the names printed.
+VECTOR_ISAS = [("avx512f", "AVX-512"), ("avx2", "AVX2"), ("avx", "AVX"), ("sse4_2", "SSE4.2")]
+
+
+def platform_cpu():
+    """The CPU as /proc/cpuinfo names it, with its family and model (a virtual machine's model
+    name may say only "AMD EPYC") and the widest vector instructions it has."""
+    fields = {}
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            key, _, value = line.partition(":")
+            fields.setdefault(key.strip(), value.strip())
+    except OSError:
+        return "unknown CPU"
+    flags = set(fields.get("flags", "").split())
+    isa = next((name for flag, name in VECTOR_ISAS if flag in flags), "SSE2")
+    return (
+        f"{fields.get('model name', 'unknown CPU')} (family {fields.get('cpu family', '?')} "
+        f"model {fields.get('model', '?')}, {isa})"
+    )
 
 
 def main():
