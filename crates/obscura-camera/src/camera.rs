@@ -92,10 +92,16 @@ pub struct CameraRayDifferential {
 
 /// True when `origin` is finite and `direction` a unit vector to 1e-3: a ray a renderer can
 /// trace (a NaN direction fails the comparison too).
+///
+/// Written without branches, since every camera ray through [`AnyCamera`](crate::AnyCamera)
+/// takes it: `x - x` is 0 for a finite `x` and NaN for an infinite or NaN one, so the sum
+/// of the three is 0 exactly when the origin is finite.
 #[inline]
 pub(crate) fn traceable(origin: Point3<World>, direction: Vector3<World>) -> bool {
     let (o, d) = (origin.to_glam(), direction.to_glam());
-    o.is_finite() && (d.length_squared() - 1.0).abs() <= 1e-3
+    let finite = (o - o).element_sum() == 0.0;
+    let unit = (d.length_squared() - 1.0).abs() <= 1e-3;
+    finite & unit
 }
 
 /// A camera model: rays from samples, and the inverse, world points to raster positions.
@@ -624,5 +630,24 @@ mod tests {
             look_at_pose(bad, None, shutter),
             Err(CameraError::Pose(_))
         ));
+    }
+
+    #[test]
+    fn traceable_needs_a_finite_origin_and_a_unit_direction() {
+        let unit = Vector3::<World>::new(0.0, 0.6, 0.8);
+        assert!(traceable(Point3::new(1e30, -2.0, 0.0), unit));
+        for bad in [f32::INFINITY, f32::NEG_INFINITY, f32::NAN] {
+            for axis in 0..3 {
+                let mut o = [1.0f32, -2.0, 3.0];
+                o[axis] = bad;
+                assert!(!traceable(Point3::new(o[0], o[1], o[2]), unit), "{o:?}");
+            }
+        }
+        let o = Point3::new(0.0, 0.0, 0.0);
+        // The fuzz target's underflowed thin lens normalised to length 1.0075.
+        assert!(!traceable(o, Vector3::new(0.0, 0.0, 1.0075)));
+        assert!(traceable(o, Vector3::new(0.0, 0.0, 1.0004)));
+        assert!(!traceable(o, Vector3::new(0.0, f32::NAN, 1.0)));
+        assert!(!traceable(o, Vector3::new(0.0, 0.0, 0.0)));
     }
 }
