@@ -94,12 +94,12 @@ pub struct CameraRayDifferential {
 /// trace (a NaN direction fails the comparison too).
 ///
 /// Written without branches, since every camera ray through [`AnyCamera`](crate::AnyCamera)
-/// takes it: `x - x` is 0 for a finite `x` and NaN for an infinite or NaN one, so the sum
-/// of the three is 0 exactly when the origin is finite.
+/// takes it: `0 x` is 0 for a finite `x` and NaN for an infinite or NaN one, so the sum of
+/// the three is 0 exactly when the origin is finite.
 #[inline]
 pub(crate) fn traceable(origin: Point3<World>, direction: Vector3<World>) -> bool {
     let (o, d) = (origin.to_glam(), direction.to_glam());
-    let finite = (o - o).element_sum() == 0.0;
+    let finite = (o * 0.0).element_sum() == 0.0;
     let unit = (d.length_squared() - 1.0).abs() <= 1e-3;
     finite & unit
 }
