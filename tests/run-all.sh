@@ -23,11 +23,16 @@ OBSCURA_BIN="$PWD/target/release/obscura" python3 -m pytest -q crates/obscura-py
 [ "${PIPESTATUS[0]}" -eq 0 ] || status=1
 
 echo "== browser: tests/explore/run.sh (obscura serve driven by headless Chromium)"
-if ! [ -x /usr/bin/chromium ] || ! command -v npm >/dev/null 2>&1; then
+# Only what is missing: a machine whose Node.js comes from NodeSource has npm inside its nodejs
+# package, and asking apt for Debian's npm beside it is refused as a conflict.
+missing=()
+[ -x /usr/bin/chromium ] || missing+=(chromium)
+command -v npm >/dev/null 2>&1 || missing+=(nodejs npm)
+if [ "${#missing[@]}" -gt 0 ]; then
   if [ "$(id -u)" -eq 0 ]; then
-    apt-get update -qq && apt-get install -y -qq chromium nodejs npm >/dev/null || status=1
+    apt-get update -qq && apt-get install -y -qq "${missing[@]}" >/dev/null || status=1
   else
-    echo "tests: chromium, nodejs and npm are needed (apt-get install chromium nodejs npm)" >&2
+    echo "tests: ${missing[*]} needed (apt-get install ${missing[*]})" >&2
   fi
 fi
 bash tests/explore/run.sh 2>&1 | tee target/test-browser.log
