@@ -36,7 +36,7 @@ import sys
 import time
 from pathlib import Path
 
-from equal_error import platform_cpu
+import equal_error
 
 ROOT = Path(__file__).resolve().parent.parent
 TARGET = Path(os.environ.get("CARGO_TARGET_DIR", ROOT / "target"))
@@ -160,8 +160,6 @@ def mitsuba_scene_dict(mi):
 
 def mitsuba_worker(variant, threads):
     pin(threads)
-    import equal_error
-
     equal_error.set_llvm_path()
     import drjit as dr
     import mitsuba as mi
@@ -410,7 +408,7 @@ def main():
     SCRATCH.mkdir(parents=True, exist_ok=True)
     if not args.no_build:
         cargo_build()
-    machine = platform_cpu()
+    machine = equal_error.platform_cpu()
     print(f"machine: {os.cpu_count()} CPUs, {machine}; load {os.getloadavg()}")
     # Both Embree and Obscura ask for huge pages for a large BVH; the kernel grants them only
     # when this says [always] or [madvise].
@@ -437,8 +435,6 @@ def main():
         bench_scaling(results)
     if args.only in (None, "error"):
         # Time to equal error on the comparison scenes (bench/equal_error.py).
-        import equal_error
-
         machines["error"] = machine
         results["error"] = equal_error.run(list(equal_error.SCENES), [16, 64, 256], 2)
     saved.write_text(json.dumps(results, indent=2))
