@@ -13,6 +13,9 @@
 //!   answers [`Scene::intersect`] and [`Scene::occluded`] from any number of threads;
 //!   [`Scene::intersect_preliminary`] finds the same closest hit without building its full
 //!   record (distance, ids and barycentrics only, like Embree's `rtcIntersect1`);
+//!   [`Scene::intersect_batch`], [`Scene::intersect_preliminary_batch`] and
+//!   [`Scene::occluded_batch`] answer many rays at once, the same answers, faster on large
+//!   meshes (their BVH traversals take turns so that their cache misses overlap);
 //!   [`SceneBuilder::with_uv`] turns off the hits' surface coordinates for callers that read
 //!   no textures.
 //! - Hits: [`Hit`] carries the world-space point with a conservative error bound, and
@@ -60,6 +63,7 @@ mod obj;
 mod pages;
 mod scene;
 mod shape;
+mod simd;
 mod wide;
 
 pub use error::AccelError;

@@ -175,6 +175,17 @@ impl PlainRay {
     }
 }
 
+impl From<&PlainRay> for crate::wide::BatchRay {
+    fn from(r: &PlainRay) -> Self {
+        crate::wide::BatchRay {
+            o: r.o,
+            d: r.d,
+            t_min: r.t_min,
+            t_max: r.t_max,
+        }
+    }
+}
+
 /// The ray's origin and direction carried into object space.
 #[inline]
 fn to_object(object_from_world: &Transform<Object, World>, r: &PlainRay) -> (Vec3A, Vec3A) {

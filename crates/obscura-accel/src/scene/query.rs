@@ -4,7 +4,7 @@
 use super::{Analytic, Found, Item, PlainRay, Scene, Top, to_object};
 use crate::geom::intersect_sphere;
 use crate::hit::Hit;
-use crate::wide::{BoxSet, WideBvh};
+use crate::wide::{BatchRay, BoxSet, WideBvh};
 use glam::{Vec2, Vec3};
 use obscura_space::{Bounds3, Ray, World};
 use obvhs::ray::RayHit;
@@ -116,6 +116,201 @@ impl Scene {
             ray: r,
             found,
         })
+    }
+
+    /// Whether the batch queries ([`intersect_batch`](Scene::intersect_batch),
+    /// [`occluded_batch`](Scene::occluded_batch)) can be faster than one ray at a time here:
+    /// only the static triangles' BVH is traversed in turns, and only when it is too large
+    /// for the caches nearest the core (a few MB: about 40,000 triangles or more). Spheres,
+    /// quads, moving meshes and small meshes are answered one ray at a time either way, so a
+    /// caller that would gather rays just for the batch need not when this is false. The
+    /// answers are the same either way.
+    pub fn batches(&self) -> bool {
+        self.flat.as_ref().is_some_and(WideBvh::interleaves)
+    }
+
+    /// The closest hit of each ray in `rays`, in order: the same as [`intersect`](Scene::intersect)
+    /// on each, but on a large mesh several rays are traversed in turns so that their cache
+    /// misses overlap (faster per ray where the BVH does not fit the cache).
+    pub fn intersect_batch(&self, rays: &[Ray<World>]) -> Vec<Option<Hit>> {
+        self.found_batch(rays)
+            .into_iter()
+            .map(|f| f.map(|(r, found)| self.finish(&r, found)))
+            .collect()
+    }
+
+    /// The closest hit of each ray in `rays` before its record is built, in order: the same
+    /// as [`intersect_preliminary`](Scene::intersect_preliminary) on each, with the batch
+    /// traversal of [`intersect_batch`](Scene::intersect_batch).
+    pub fn intersect_preliminary_batch(
+        &self,
+        rays: &[Ray<World>],
+    ) -> Vec<Option<PreliminaryHit<'_>>> {
+        self.found_batch(rays)
+            .into_iter()
+            .map(|f| {
+                f.map(|(ray, found)| PreliminaryHit {
+                    scene: self,
+                    ray,
+                    found,
+                })
+            })
+            .collect()
+    }
+
+    /// What [`found`](Scene::found) gives for each ray, with the ray as checked. Each ray
+    /// visits the items exactly as `found` does; where that order reaches the flattened
+    /// triangles, the ray waits, and the waiting rays go through their BVH together
+    /// ([`WideBvh::closest_batch`]) before each goes on with the items after it.
+    fn found_batch(&self, rays: &[Ray<World>]) -> Vec<Option<(PlainRay, Found)>> {
+        let plain = rays.iter().map(PlainRay::new);
+        let Some(flat) = self.flat.as_ref() else {
+            return plain
+                .map(|r| r.and_then(|r| Some((r, self.found(&r)?))))
+                .collect();
+        };
+        match &self.tlas {
+            Top::One if self.items.len() == 1 => {
+                let plain: Vec<Option<PlainRay>> = plain.collect();
+                let batch: Vec<BatchRay> = plain.iter().flatten().map(BatchRay::from).collect();
+                let mut hits = vec![None; batch.len()];
+                flat.closest_batch(&batch, &mut hits);
+                let mut hits = hits.into_iter();
+                plain
+                    .into_iter()
+                    .map(|r| {
+                        let r = r?;
+                        let hit = hits.next().flatten()?;
+                        Some((r, Found::Flat { hit }))
+                    })
+                    .collect()
+            }
+            Top::Few { set, sorted: true } => {
+                // Each ray's walk over the boxes it enters, nearest first, as in `found`:
+                // up to the flattened triangles, then (after the batch) on from there.
+                struct Walk {
+                    r: PlainRay,
+                    entered: [(usize, f32); BoxSet::CAPACITY],
+                    n: usize,
+                    next: usize,
+                    best: Option<Found>,
+                    t_best: f32,
+                }
+                let walk = |w: &mut Walk| -> bool {
+                    while w.next < w.n {
+                        let (item, t_entry) = w.entered[w.next];
+                        if t_entry > w.t_best {
+                            w.next = w.n;
+                            break;
+                        }
+                        if matches!(self.items[item], Item::Flat) {
+                            return true;
+                        }
+                        w.next += 1;
+                        if let Some(f) = self.intersect_item(item, &w.r, w.t_best) {
+                            w.t_best = f.t();
+                            w.best = Some(f);
+                        }
+                    }
+                    false
+                };
+                let mut walks: Vec<Option<Walk>> = plain
+                    .map(|r| {
+                        let r = r?;
+                        let mut entered = [(0, 0.0); BoxSet::CAPACITY];
+                        let n = set.entered(r.o, r.d, r.t_min, r.t_max, &mut entered);
+                        Some(Walk {
+                            r,
+                            entered,
+                            n,
+                            next: 0,
+                            best: None,
+                            t_best: r.t_max,
+                        })
+                    })
+                    .collect();
+                let mut waiting = Vec::new();
+                let mut batch = Vec::new();
+                for (k, w) in walks.iter_mut().enumerate() {
+                    if let Some(w) = w
+                        && walk(w)
+                    {
+                        waiting.push(k);
+                        batch.push(BatchRay {
+                            t_max: w.t_best,
+                            ..BatchRay::from(&w.r)
+                        });
+                    }
+                }
+                let mut hits = vec![None; batch.len()];
+                flat.closest_batch(&batch, &mut hits);
+                for (k, hit) in waiting.into_iter().zip(hits) {
+                    if let Some(w) = &mut walks[k] {
+                        w.next += 1;
+                        if let Some(hit) = hit {
+                            w.t_best = hit.tri.t;
+                            w.best = Some(Found::Flat { hit });
+                        }
+                        // One flat item only: the rest of the walk needs no batch.
+                        walk(w);
+                    }
+                }
+                walks
+                    .into_iter()
+                    .map(|w| w.and_then(|w| Some((w.r, w.best?))))
+                    .collect()
+            }
+            _ => plain
+                .map(|r| r.and_then(|r| Some((r, self.found(&r)?))))
+                .collect(),
+        }
+    }
+
+    /// Whether anything is hit, for each ray in `rays`, in order: the same as
+    /// [`occluded`](Scene::occluded) on each, with the flattened triangles' BVH queried for
+    /// all the rays together as in [`intersect_batch`](Scene::intersect_batch) (any-hit
+    /// queries visit items in no particular order, so the answer is the same).
+    pub fn occluded_batch(&self, rays: &[Ray<World>]) -> Vec<bool> {
+        let Some(flat) = self.flat.as_ref() else {
+            return rays.iter().map(|r| self.occluded(r)).collect();
+        };
+        let flat_lane = self.items.iter().position(|i| matches!(i, Item::Flat));
+        let mut out = Vec::with_capacity(rays.len());
+        let mut waiting = Vec::new();
+        let mut batch = Vec::new();
+        for ray in rays {
+            let Some(r) = PlainRay::new(ray) else {
+                out.push(false);
+                continue;
+            };
+            let mask = match &self.tlas {
+                Top::One if self.items.len() == 1 => 1,
+                Top::Few { set, .. } => set.entered_mask(r.o, r.d, r.t_min, r.t_max),
+                _ => {
+                    out.push(self.occluded(ray));
+                    continue;
+                }
+            };
+            let flat_bit = flat_lane.map_or(0, |lane| 1 << lane) & mask;
+            let mut others = mask & !flat_bit;
+            let mut hit = false;
+            while others != 0 && !hit {
+                let item = others.trailing_zeros() as usize;
+                others &= others - 1;
+                hit = self.occluded_item(item, &r);
+            }
+            if !hit && flat_bit != 0 {
+                waiting.push(out.len());
+                batch.push(BatchRay::from(&r));
+            }
+            out.push(hit);
+        }
+        let mut hits = vec![false; batch.len()];
+        flat.any_batch(&batch, &mut hits);
+        for (k, hit) in waiting.into_iter().zip(hits) {
+            out[k] = hit;
+        }
+        out
     }
 
     /// The closest hit on any item, before its record is built.

@@ -19,18 +19,26 @@
 //! meantime. Large arrays live on transparent huge pages ([`Pages`]), so the visits are not
 //! also TLB misses.
 //!
-//! The files: `layout.rs` (nodes and packets), `collapse.rs` (the build), `ray.rs` (the slab
-//! and triangle tests), `traverse.rs` (the queries), `boxset.rs` (a top level of few boxes).
+//! A batch of rays on a large tree is traversed in turns (`batch.rs`): eight rays in flight,
+//! each taking one step and asking for the lines of its next node before the next ray's step,
+//! so that the rays' cache misses overlap instead of following one another.
 //!
-//! Everything is safe Rust: the lanes are glam's `Vec4` (an SSE register on x86-64) or arrays
-//! the compiler vectorises.
+//! The files: `layout.rs` (nodes and packets), `collapse.rs` (the build), `ray.rs` (the slab
+//! and triangle tests), `traverse.rs` (the queries, one step at a time), `batch.rs` (batches
+//! in turns), `boxset.rs` (a top level of few boxes).
+//!
+//! Everything here is safe Rust: the lanes are glam's `Vec4` (an SSE register on x86-64) or
+//! arrays the compiler vectorises; the one prefetch instruction is in the crate's `simd`
+//! module.
 
+mod batch;
 mod boxset;
 mod collapse;
 mod layout;
 mod ray;
 mod traverse;
 
+pub(crate) use batch::BatchRay;
 pub(crate) use boxset::BoxSet;
 
 use crate::geom::TriangleHit;

@@ -55,8 +55,6 @@ impl WideBvh {
         })
     }
 
-    /// Front-to-back traversal: of the children a ray enters, the nearest is visited next and
-    /// the others are stacked with their entry distance, so a later hit can skip them.
     #[inline(always)]
     fn closest_with<const SLACK: bool>(
         &self,
@@ -66,85 +64,12 @@ impl WideBvh {
         t_min: f32,
         t_max: f32,
     ) -> Option<WideHit> {
-        let ray = Prepared::<SLACK>::new(o, d);
         let (nodes, packets) = (&*self.nodes, &*self.packets);
-        // The packet and lane of the best hit so far, with the hit.
-        let mut best: Option<(usize, usize, TriangleHit)> = None;
+        let mut q = Closest::<SLACK>::new(self.root, o, d, t_min, t_max);
         let mut warm = 0u32;
-        let mut t_best = t_max;
-        let mut current = self.root;
-        loop {
-            if current & LEAF == 0 {
-                let node = &nodes[current as usize];
-                let (t_near, mask) = ray.slabs::<ARITY>(node, t_min, t_best);
-                if mask != 0 {
-                    let rest = mask & (mask - 1);
-                    if rest == 0 {
-                        current = node.child[mask.trailing_zeros() as usize & 7];
-                        continue;
-                    }
-                    if rest & (rest - 1) == 0 {
-                        // Exactly two: no sort, the nearer goes next and the other is stacked
-                        // (the order the sort below would give, ties to the lower lane).
-                        let (a, b) = (
-                            mask.trailing_zeros() as usize & 7,
-                            rest.trailing_zeros() as usize & 7,
-                        );
-                        let (ta, tb) = (t_near[a], t_near[b]);
-                        let (near, far, t_far) = if tb < ta { (b, a, ta) } else { (a, b, tb) };
-                        let far_child = node.child[far];
-                        warm ^= touch(nodes, packets, far_child);
-                        stack.push((far_child, t_far));
-                        current = node.child[near];
-                        continue;
-                    }
-                    // Three to eight children: sort them by entry distance, nearest first.
-                    let mut hits = [(0u32, 0f32); ARITY];
-                    let n = by_entry(mask, &t_near, |lane| node.child[lane], &mut hits);
-                    for &entry in hits[1..n].iter().rev() {
-                        warm ^= touch(nodes, packets, entry.0);
-                        stack.push(entry);
-                    }
-                    current = hits[0].0;
-                    continue;
-                }
-            } else if current != EMPTY {
-                let index = (current & !LEAF) as usize;
-                let packet = &packets[index];
-                let (mask, t, b1, b2) = ray.triangles(packet, t_min, t_best);
-                if mask != 0 {
-                    let (t, b1, b2) = (t.to_array(), b1.to_array(), b2.to_array());
-                    let mut m = mask;
-                    while m != 0 {
-                        let lane = m.trailing_zeros() as usize & 3;
-                        m &= m - 1;
-                        if t[lane] <= t_best {
-                            t_best = t[lane];
-                            best = Some((
-                                index,
-                                lane,
-                                TriangleHit {
-                                    t: t[lane],
-                                    b1: b1[lane],
-                                    b2: b2[lane],
-                                },
-                            ));
-                        }
-                    }
-                }
-            }
-            // Next: the nearest stacked child not already beyond the best hit.
-            loop {
-                let Some((next, t_entry)) = stack.pop() else {
-                    std::hint::black_box(warm);
-                    return best.map(|(index, lane, tri)| hit_record(&packets[index], lane, tri));
-                };
-                if t_entry <= t_best {
-                    current = next;
-                    break;
-                }
-            }
-        }
+        while q.step::<true>(nodes, packets, stack, &mut warm) {}
+        std::hint::black_box(warm);
+        q.hit(packets)
     }
 
     #[inline(always)]
@@ -156,37 +81,213 @@ impl WideBvh {
         t_min: f32,
         t_max: f32,
     ) -> bool {
-        let ray = Prepared::<SLACK>::new(o, d);
         let (nodes, packets) = (&*self.nodes, &*self.packets);
+        let mut q = Any::<SLACK>::new(self.root, o, d, t_min, t_max);
         let mut warm = 0u32;
-        let mut current = self.root;
-        loop {
-            if current & LEAF == 0 {
-                let node = &nodes[current as usize];
-                let (_, mut mask) = ray.slabs::<ARITY>(node, t_min, t_max);
-                if mask != 0 {
-                    current = node.child[mask.trailing_zeros() as usize & 7];
-                    mask &= mask - 1;
-                    while mask != 0 {
-                        let child = node.child[mask.trailing_zeros() as usize & 7];
-                        warm ^= touch(nodes, packets, child);
-                        stack.push(child);
-                        mask &= mask - 1;
-                    }
-                    continue;
-                }
-            } else if current != EMPTY {
-                let packet = &packets[(current & !LEAF) as usize];
-                if ray.triangles(packet, t_min, t_max).0 != 0 {
-                    std::hint::black_box(warm);
+        let hit = loop {
+            match q.step::<true>(nodes, packets, stack, &mut warm) {
+                Step::Next => {}
+                Step::Hit => break true,
+                Step::Done => break false,
+            }
+        };
+        std::hint::black_box(warm);
+        hit
+    }
+}
+
+/// A closest-hit query under way: where it is, and the best hit so far.
+pub(super) struct Closest<const SLACK: bool> {
+    ray: Prepared<SLACK>,
+    t_min: f32,
+    t_best: f32,
+    /// The node or packet the next step visits.
+    pub(super) current: u32,
+    /// The packet and lane of the best hit so far, with the hit.
+    best: Option<(usize, usize, TriangleHit)>,
+}
+
+impl<const SLACK: bool> Closest<SLACK> {
+    /// A query from `root` for the ray from `o` along `d` over `[t_min, t_max]`.
+    #[inline(always)]
+    pub(super) fn new(root: u32, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> Self {
+        Closest {
+            ray: Prepared::<SLACK>::new(o, d),
+            t_min,
+            t_best: t_max,
+            current: root,
+            best: None,
+        }
+    }
+
+    /// One step of front-to-back traversal: the box test of the node the query is at (of
+    /// the children it enters, the nearest is visited next and the others are stacked with
+    /// their entry distance, so a later hit can skip them) or the triangle test of the
+    /// packet; then where to go next. False when there is nowhere left to go. `TOUCH`: read
+    /// one word of each line of a stacked child, so its lines load in the meantime.
+    #[inline(always)]
+    pub(super) fn step<const TOUCH: bool>(
+        &mut self,
+        nodes: &[Node],
+        packets: &[Packet],
+        stack: &mut Vec<(u32, f32)>,
+        warm: &mut u32,
+    ) -> bool {
+        let current = self.current;
+        if current & LEAF == 0 {
+            let node = &nodes[current as usize];
+            let (t_near, mask) = self.ray.slabs::<ARITY>(node, self.t_min, self.t_best);
+            if mask != 0 {
+                let rest = mask & (mask - 1);
+                if rest == 0 {
+                    self.current = node.child[mask.trailing_zeros() as usize & 7];
                     return true;
                 }
+                if rest & (rest - 1) == 0 {
+                    // Exactly two: no sort, the nearer goes next and the other is stacked
+                    // (the order the sort below would give, ties to the lower lane).
+                    let (a, b) = (
+                        mask.trailing_zeros() as usize & 7,
+                        rest.trailing_zeros() as usize & 7,
+                    );
+                    let (ta, tb) = (t_near[a], t_near[b]);
+                    let (near, far, t_far) = if tb < ta { (b, a, ta) } else { (a, b, tb) };
+                    let far_child = node.child[far];
+                    if TOUCH {
+                        *warm ^= touch(nodes, packets, far_child);
+                    }
+                    stack.push((far_child, t_far));
+                    self.current = node.child[near];
+                    return true;
+                }
+                // Three to eight children: sort them by entry distance, nearest first.
+                let mut hits = [(0u32, 0f32); ARITY];
+                let n = by_entry(mask, &t_near, |lane| node.child[lane], &mut hits);
+                for &entry in hits[1..n].iter().rev() {
+                    if TOUCH {
+                        *warm ^= touch(nodes, packets, entry.0);
+                    }
+                    stack.push(entry);
+                }
+                self.current = hits[0].0;
+                return true;
             }
-            let Some(next) = stack.pop() else {
-                std::hint::black_box(warm);
+        } else if current != EMPTY {
+            let index = (current & !LEAF) as usize;
+            let packet = &packets[index];
+            let (mask, t, b1, b2) = self.ray.triangles(packet, self.t_min, self.t_best);
+            if mask != 0 {
+                let (t, b1, b2) = (t.to_array(), b1.to_array(), b2.to_array());
+                let mut m = mask;
+                while m != 0 {
+                    let lane = m.trailing_zeros() as usize & 3;
+                    m &= m - 1;
+                    if t[lane] <= self.t_best {
+                        self.t_best = t[lane];
+                        self.best = Some((
+                            index,
+                            lane,
+                            TriangleHit {
+                                t: t[lane],
+                                b1: b1[lane],
+                                b2: b2[lane],
+                            },
+                        ));
+                    }
+                }
+            }
+        }
+        // Next: the nearest stacked child not already beyond the best hit.
+        loop {
+            let Some((next, t_entry)) = stack.pop() else {
                 return false;
             };
-            current = next;
+            if t_entry <= self.t_best {
+                self.current = next;
+                return true;
+            }
+        }
+    }
+
+    /// The hit found, once [`step`](Closest::step) has returned false.
+    #[inline(always)]
+    pub(super) fn hit(&self, packets: &[Packet]) -> Option<WideHit> {
+        self.best
+            .map(|(index, lane, tri)| hit_record(&packets[index], lane, tri))
+    }
+}
+
+/// What an any-hit step found.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub(super) enum Step {
+    /// Go on: the query has somewhere left to go.
+    Next,
+    /// A triangle is hit: the query's answer is true.
+    Hit,
+    /// Nowhere left to go and nothing hit.
+    Done,
+}
+
+/// An any-hit query under way.
+pub(super) struct Any<const SLACK: bool> {
+    ray: Prepared<SLACK>,
+    t_min: f32,
+    t_max: f32,
+    /// The node or packet the next step visits.
+    pub(super) current: u32,
+}
+
+impl<const SLACK: bool> Any<SLACK> {
+    /// A query from `root` for the ray from `o` along `d` over `[t_min, t_max]`.
+    #[inline(always)]
+    pub(super) fn new(root: u32, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> Self {
+        Any {
+            ray: Prepared::<SLACK>::new(o, d),
+            t_min,
+            t_max,
+            current: root,
+        }
+    }
+
+    /// One step: a node's entered children are stacked in lane order (any order will do),
+    /// or a packet's triangles tested; then where to go next. `TOUCH` as for [`Closest`].
+    #[inline(always)]
+    pub(super) fn step<const TOUCH: bool>(
+        &mut self,
+        nodes: &[Node],
+        packets: &[Packet],
+        stack: &mut Vec<u32>,
+        warm: &mut u32,
+    ) -> Step {
+        let current = self.current;
+        if current & LEAF == 0 {
+            let node = &nodes[current as usize];
+            let (_, mut mask) = self.ray.slabs::<ARITY>(node, self.t_min, self.t_max);
+            if mask != 0 {
+                self.current = node.child[mask.trailing_zeros() as usize & 7];
+                mask &= mask - 1;
+                while mask != 0 {
+                    let child = node.child[mask.trailing_zeros() as usize & 7];
+                    if TOUCH {
+                        *warm ^= touch(nodes, packets, child);
+                    }
+                    stack.push(child);
+                    mask &= mask - 1;
+                }
+                return Step::Next;
+            }
+        } else if current != EMPTY {
+            let packet = &packets[(current & !LEAF) as usize];
+            if self.ray.triangles(packet, self.t_min, self.t_max).0 != 0 {
+                return Step::Hit;
+            }
+        }
+        match stack.pop() {
+            Some(next) => {
+                self.current = next;
+                Step::Next
+            }
+            None => Step::Done,
         }
     }
 }

@@ -1,0 +1,192 @@
+//! Batch queries: several rays traversed in turns, so that their cache misses overlap.
+//!
+//! A query on a large mesh waits on memory at nearly every node it visits, one dependent miss
+//! after another, and one query's out-of-order window is too short to overlap them. A batch
+//! keeps [`LANES`] rays in flight: each takes one step (a node's box test or a packet's
+//! triangle test), asks for the lines of the node or packet it will visit next
+//! ([`prefetch`]), and yields to the next ray, so by the time a ray's turn comes round again
+//! its lines have had the other rays' steps to arrive. A ray that finishes hands its lane to
+//! the next ray of the batch.
+//!
+//! Each ray takes exactly the steps of the one-ray query ([`Closest::step`], [`Any::step`],
+//! shared with it), so every answer equals what [`WideBvh::closest`] or [`WideBvh::any`]
+//! gives for that ray.
+
+use super::layout::{LEAF, Node, Packet};
+use super::traverse::{Any, Closest, Step};
+use super::{WideBvh, WideHit};
+use crate::simd::prefetch;
+use glam::Vec3A;
+
+/// Rays in flight at once.
+pub(crate) const LANES: usize = 8;
+
+/// The smallest tree whose batches take turns between rays: above a core's L2 (512 KiB to
+/// 2 MiB on current x86-64) with room to spare. On the terrain of the mesh comparison scene,
+/// turns cost time at 0.7 MB of tree and paid from about 3 MB (docs/performance.md).
+pub(crate) const INTERLEAVE_MIN_BYTES: usize = 4 << 20;
+
+/// One ray of a batch query: origin, direction and its range.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct BatchRay {
+    pub o: Vec3A,
+    pub d: Vec3A,
+    pub t_min: f32,
+    pub t_max: f32,
+}
+
+impl WideBvh {
+    /// The closest hit of each ray, `out[i]` for `rays[i]`, each exactly as
+    /// [`closest`](WideBvh::closest) finds it. `out` is as long as `rays`.
+    pub(crate) fn closest_batch(&self, rays: &[BatchRay], out: &mut [Option<WideHit>]) {
+        if self.interleaves() {
+            self.closest_interleaved(rays, out);
+        } else {
+            for (r, o) in rays.iter().zip(out) {
+                *o = self.closest(r.o, r.d, r.t_min, r.t_max);
+            }
+        }
+    }
+
+    /// [`closest_batch`](WideBvh::closest_batch) taking turns between rays, whatever the
+    /// tree's size.
+    pub(super) fn closest_interleaved(&self, rays: &[BatchRay], out: &mut [Option<WideHit>]) {
+        let packets = &*self.packets;
+        self.run(
+            rays,
+            out,
+            |r| {
+                // A ray that may start behind its origin has the other box test: it takes the
+                // one-ray query.
+                if r.t_min >= 0.0 {
+                    Ok(Closest::<false>::new(self.root, r.o, r.d, r.t_min, r.t_max))
+                } else {
+                    Err(self.closest(r.o, r.d, r.t_min, r.t_max))
+                }
+            },
+            |q, nodes, stack| {
+                if q.step::<false>(nodes, packets, stack, &mut 0) {
+                    None
+                } else {
+                    Some(q.hit(packets))
+                }
+            },
+            |q| q.current,
+        );
+    }
+
+    /// Whether each ray hits anything, `out[i]` for `rays[i]`, each exactly as
+    /// [`any`](WideBvh::any) answers it. `out` is as long as `rays`.
+    pub(crate) fn any_batch(&self, rays: &[BatchRay], out: &mut [bool]) {
+        if self.interleaves() {
+            self.any_interleaved(rays, out);
+        } else {
+            for (r, o) in rays.iter().zip(out) {
+                *o = self.any(r.o, r.d, r.t_min, r.t_max);
+            }
+        }
+    }
+
+    /// [`any_batch`](WideBvh::any_batch) taking turns between rays, whatever the tree's size.
+    pub(super) fn any_interleaved(&self, rays: &[BatchRay], out: &mut [bool]) {
+        let packets = &*self.packets;
+        self.run(
+            rays,
+            out,
+            |r| {
+                if r.t_min >= 0.0 {
+                    Ok(Any::<false>::new(self.root, r.o, r.d, r.t_min, r.t_max))
+                } else {
+                    Err(self.any(r.o, r.d, r.t_min, r.t_max))
+                }
+            },
+            |q, nodes, stack| match q.step::<false>(nodes, packets, stack, &mut 0) {
+                Step::Next => None,
+                Step::Hit => Some(true),
+                Step::Done => Some(false),
+            },
+            |q| q.current,
+        );
+    }
+
+    /// Whether a batch takes turns between rays: only for a tree too large for the caches
+    /// nearest the core, where the turns hide misses. A smaller tree's lines are mostly at
+    /// hand, and taking turns would only add the switching; its batch runs one ray after
+    /// another ([`INTERLEAVE_MIN_BYTES`]).
+    pub(crate) fn interleaves(&self) -> bool {
+        self.heap_bytes() >= INTERLEAVE_MIN_BYTES
+    }
+
+    /// The batch loop: `start` makes a ray's query (or answers it at once), `advance` takes
+    /// one step of a query and gives its answer when it has one, `at` names what a query
+    /// visits next.
+    #[inline(always)]
+    fn run<Q, E, T>(
+        &self,
+        rays: &[BatchRay],
+        out: &mut [T],
+        start: impl Fn(&BatchRay) -> Result<Q, T>,
+        advance: impl Fn(&mut Q, &[Node], &mut Vec<E>) -> Option<T>,
+        at: impl Fn(&Q) -> u32,
+    ) {
+        let (nodes, packets) = (&*self.nodes, &*self.packets);
+        let mut flights: Vec<(Q, usize, Vec<E>)> = Vec::with_capacity(LANES);
+        let mut stacks: Vec<Vec<E>> = Vec::with_capacity(LANES);
+        let mut slots = 0..rays.len().min(out.len());
+        // The next ray that needs a traversal, answering the others on the way.
+        let mut next = |stacks: &mut Vec<Vec<E>>, out: &mut [T]| {
+            for slot in slots.by_ref() {
+                match start(&rays[slot]) {
+                    Ok(q) => {
+                        let mut stack = stacks.pop().unwrap_or_default();
+                        stack.clear();
+                        return Some((q, slot, stack));
+                    }
+                    Err(answer) => out[slot] = answer,
+                }
+            }
+            None
+        };
+        while flights.len() < LANES {
+            match next(&mut stacks, out) {
+                Some(flight) => flights.push(flight),
+                None => break,
+            }
+        }
+        while !flights.is_empty() {
+            let mut i = 0;
+            while i < flights.len() {
+                let (q, slot, stack) = &mut flights[i];
+                let Some(answer) = advance(q, nodes, stack) else {
+                    ask(nodes, packets, at(q));
+                    i += 1;
+                    continue;
+                };
+                out[*slot] = answer;
+                match next(&mut stacks, out) {
+                    Some(fresh) => {
+                        let (_, _, stack) = std::mem::replace(&mut flights[i], fresh);
+                        stacks.push(stack);
+                        i += 1;
+                    }
+                    None => {
+                        let (_, _, stack) = flights.swap_remove(i);
+                        stacks.push(stack);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Asks for the lines of the node or packet `r` names.
+#[inline(always)]
+fn ask(nodes: &[Node], packets: &[Packet], r: u32) {
+    if r & LEAF == 0 {
+        if let Some(node) = nodes.get(r as usize) {
+            prefetch(node, size_of::<Node>() / 64 - 1);
+        }
+    } else if let Some(packet) = packets.get((r & !LEAF) as usize) {
+        prefetch(packet, size_of::<Packet>() / 64 - 1);
+    }
+}
