@@ -297,28 +297,67 @@ fn render_tile(
     let uses_lens = scene.camera.uses_lens_sample();
     let uses_time = scene.camera.uses_time_sample()
         && (scene.camera.world_from_camera().is_animated() || scene.geometry.moves());
+    // Every pixel's camera ray first, then the tile's paths traced together (their rays go
+    // through the geometry in batches), then the samples added in pixel order, so that the
+    // tile's sums are the same as one pixel after another would make them.
+    let mut streams = Vec::with_capacity(tile.area() as usize);
+    let mut rays = Vec::with_capacity(tile.area() as usize);
+    // Each pixel's film position, and its camera ray's weight and index in `rays`.
+    let mut samples = Vec::with_capacity(tile.area() as usize);
     for y in tile.y0..tile.y1 {
         for x in tile.x0..tile.x1 {
             stats.samples += 1;
             let mut stream = scene.sampler.stream([x, y], index);
             let sample = CameraSample::from_stream(&mut stream, [x, y], uses_lens, uses_time);
-            let p_film = sample.p_film.to_glam();
-            let Some(camera_ray) = scene.camera.generate_ray(&sample) else {
-                // No ray: the sample sees nothing, but still counts in the pixel's mean.
-                stats.no_ray += 1;
-                buffer.add_sample(p_film, Vec3::ZERO, false);
-                continue;
-            };
-            let (value, hit) = sample_value(scene, path, &camera_ray.ray, &mut stream);
-            let value = value * camera_ray.weight;
-            if !value.is_finite() {
-                stats.dropped_nonfinite += 1;
-                continue;
+            let camera_ray = scene.camera.generate_ray(&sample);
+            if let Some(camera_ray) = &camera_ray {
+                streams.push(stream);
+                rays.push(camera_ray.ray);
             }
-            buffer.add_sample(p_film, value, hit);
+            samples.push((sample.p_film.to_glam(), camera_ray.map(|r| r.weight)));
         }
     }
+    let mut values = sample_values(scene, path, &rays, &mut streams).into_iter();
+    for (p_film, weight) in samples {
+        let Some(weight) = weight else {
+            // No ray: the sample sees nothing, but still counts in the pixel's mean.
+            stats.no_ray += 1;
+            buffer.add_sample(p_film, Vec3::ZERO, false);
+            continue;
+        };
+        let (value, hit) = values.next().expect("one value per camera ray");
+        let value = value * weight;
+        if !value.is_finite() {
+            stats.dropped_nonfinite += 1;
+            continue;
+        }
+        buffer.add_sample(p_film, value, hit);
+    }
     stats
+}
+
+/// [`sample_value`] for each of `rays` with its own stream; the path integrator traces them
+/// together ([`PathIntegrator::li_and_hit_batch`]), with the same values.
+fn sample_values(
+    scene: &RenderScene,
+    path: &PathIntegrator,
+    rays: &[Ray<World>],
+    streams: &mut [SampleStream<'_>],
+) -> Vec<(Vec3, bool)> {
+    if scene.integrator() != IntegratorKind::Path {
+        return rays
+            .iter()
+            .zip(streams)
+            .map(|(ray, stream)| sample_value(scene, path, ray, stream))
+            .collect();
+    }
+    let mut values = path.li_and_hit_batch(&scene.geometry, &scene.shading, rays, streams);
+    if let Some(scale) = scene.exposure_scale {
+        for (radiance, _) in &mut values {
+            *radiance *= scale;
+        }
+    }
+    values
 }
 
 /// The integrator's value for one camera ray, and whether the ray hit geometry.

@@ -244,6 +244,68 @@ impl PathIntegrator {
         self.trace(geometry, shading, ray, dims)
     }
 
+    /// [`li_and_hit`](PathIntegrator::li_and_hit) for many camera rays at once: `rays[i]`'s
+    /// path draws its numbers from `dims[i]` and its value is the `i`-th returned, exactly
+    /// (bit for bit) what `li_and_hit` gives for it. The paths advance together, one vertex
+    /// each per round, so each round's rays go through the geometry as one batch
+    /// ([`Scene::intersect_batch`], [`Scene::occluded_batch`]), which on a large mesh overlaps
+    /// their cache misses. Each path's arithmetic is the one-path loop's, in the same order.
+    pub fn li_and_hit_batch<D: SampleDims>(
+        &self,
+        geometry: &Scene,
+        shading: &ShadingScene,
+        rays: &[Ray<World>],
+        dims: &mut [D],
+    ) -> Vec<(Vec3, bool)> {
+        if !geometry.batches() {
+            return rays
+                .iter()
+                .zip(dims)
+                .map(|(ray, dims)| self.trace(geometry, shading, ray, dims))
+                .collect();
+        }
+        let mut out = vec![(Vec3::ZERO, false); rays.len().min(dims.len())];
+        let mut live: Vec<(usize, PathState)> = rays
+            .iter()
+            .take(dims.len())
+            .enumerate()
+            .filter_map(|(slot, ray)| Some((slot, PathState::new(ray)?)))
+            .collect();
+        let mut next_rays = Vec::with_capacity(live.len());
+        let mut pending: Vec<(usize, Shadow)> = Vec::new();
+        let mut shadow_rays = Vec::new();
+        let mut going_on = Vec::with_capacity(live.len());
+        while !live.is_empty() {
+            next_rays.clear();
+            next_rays.extend(live.iter().map(|(_, path)| path.ray));
+            let hits = geometry.intersect_batch(&next_rays);
+            going_on.clear();
+            for (k, ((slot, path), hit)) in live.iter_mut().zip(hits).enumerate() {
+                let (shadow, more) = self.vertex(shading, path, hit, &mut dims[*slot]);
+                if let Some(shadow) = shadow {
+                    pending.push((k, shadow));
+                }
+                going_on.push(more);
+            }
+            shadow_rays.clear();
+            shadow_rays.extend(pending.iter().map(|(_, shadow)| shadow.ray));
+            let blocked = geometry.occluded_batch(&shadow_rays);
+            for ((k, shadow), blocked) in pending.drain(..).zip(blocked) {
+                live[k].1.add_light(shadow, blocked);
+            }
+            let mut k = 0;
+            live.retain(|(slot, path)| {
+                let more = going_on[k];
+                k += 1;
+                if !more {
+                    out[*slot] = (path.radiance, path.camera_ray_hit);
+                }
+                more
+            });
+        }
+        out
+    }
+
     fn trace(
         &self,
         geometry: &Scene,
@@ -251,132 +313,147 @@ impl PathIntegrator {
         camera_ray: &Ray<World>,
         dims: &mut impl SampleDims,
     ) -> (Vec3, bool) {
-        let mut camera_ray_hit = false;
-        let mut radiance = Vec3::ZERO;
-        let mut beta = Vec3::ONE;
-        let mut ray = *camera_ray;
-        let Some(dir) = ray.direction.to_glam().try_normalize() else {
+        let Some(mut path) = PathState::new(camera_ray) else {
             return (Vec3::ZERO, false);
         };
-        ray.direction = Vector3::from_glam(dir);
-        // The previous scattering: was it a delta lobe, its pdf, and where it happened.
-        let mut specular_bounce = true;
-        let mut prev_pdf = 0.0f32;
-        let mut prev_p = ray.origin.to_glam();
-        let light_select = shading.light_select_pdf();
-
-        let mut depth = 0u32;
-        // The product of eta^2 over the refractions so far: beta * eta_scale is the path's
-        // throughput without the 1 / eta^2 radiance scaling, which Russian roulette must not see.
-        let mut eta_scale = 1.0f32;
         loop {
-            let d_world = ray.direction.to_glam();
-            // Find the next vertex; escaped rays see the environment.
-            let Some(hit) = geometry.intersect(&ray) else {
-                for &i in &shading.environment {
-                    let Light::Environment(env) = &shading.lights[i as usize] else {
-                        continue;
-                    };
-                    let (le, weight) = if specular_bounce {
-                        (env.radiance(d_world), 1.0)
-                    } else {
-                        let (le, pdf) = env.radiance_and_pdf(d_world);
-                        (le, power_heuristic(prev_pdf, light_select * pdf))
-                    };
-                    radiance += beta * le * weight;
-                }
-                break;
-            };
-            camera_ray_hit |= depth == 0;
-            let wo_world = -d_world;
-            let n_geometric = hit.n_geometric.to_glam();
-
-            // Emission of the surface hit, weighted against light sampling's chance of it.
-            if let Some(area) = shading.area_light(hit.instance) {
-                let le = area.emitted(n_geometric, wo_world);
-                if le != Vec3::ZERO {
-                    let weight = if specular_bounce {
-                        1.0
-                    } else {
-                        let pdf_light = light_select
-                            * area.pdf_li(
-                                prev_p,
-                                hit.p.to_glam(),
-                                n_geometric,
-                                hit.primitive,
-                                hit.time,
-                            );
-                        power_heuristic(prev_pdf, pdf_light)
-                    };
-                    radiance += beta * le * weight;
-                }
+            let hit = geometry.intersect(&path.ray);
+            let (shadow, more) = self.vertex(shading, &mut path, hit, dims);
+            if let Some(shadow) = shadow {
+                let blocked = geometry.occluded(&shadow.ray);
+                path.add_light(shadow, blocked);
             }
-            if depth >= self.max_depth {
-                break;
-            }
-            let Some(material) = shading.material(hit.instance) else {
-                break;
-            };
-
-            // The shading frame: two-sided materials face the viewer; glass keeps its side.
-            let frame = shading_frame(&hit, material, wo_world);
-            let wo = frame.to_local(wo_world);
-            if wo.z == 0.0 {
-                break;
-            }
-
-            // Next-event estimation: one light, chosen uniformly.
-            if !material.is_specular() && !shading.lights.is_empty() {
-                // With one light there is nothing to choose: the number is skipped, not drawn.
-                let u_light = dims.next_1d_if(shading.lights.len() > 1);
-                let u2_light = dims.next_2d();
-                radiance += beta
-                    * self.sample_light(
-                        geometry, shading, &hit, material, &frame, wo, u_light, u2_light,
-                    );
-            }
-
-            // Continue the path by sampling the BSDF.
-            // Only a material with a choice of lobes reads `u` (see Material::reads_lobe_choice).
-            let u = dims.next_1d_if(material.reads_lobe_choice());
-            let u2 = dims.next_2d();
-            let Some(bs) = material.sample(wo, u, u2) else {
-                break;
-            };
-            if bs.pdf < MIN_PDF || bs.f == Vec3::ZERO {
-                break;
-            }
-            let throughput = bs.f * bs.wi.z.abs() / bs.pdf;
-            if !throughput.is_finite() {
-                break;
-            }
-            beta *= throughput;
-            specular_bounce = bs.specular;
-            prev_pdf = bs.pdf;
-            prev_p = hit.p.to_glam();
-            let Some(wi_world) = frame.from_local(bs.wi).try_normalize() else {
-                break;
-            };
-            ray = spawn_ray(&hit, wi_world);
-            depth += 1;
-
-            eta_scale *= bs.eta * bs.eta;
-            // Russian roulette once the path is a few bounces long.
-            if depth >= Self::RR_START_DEPTH {
-                let survive = rr_survival(beta, eta_scale);
-                if dims.next_1d() >= survive {
-                    break;
-                }
-                beta /= survive;
+            if !more {
+                return (path.radiance, path.camera_ray_hit);
             }
         }
-        (radiance, camera_ray_hit)
     }
 
-    /// One light sample at `hit`, MIS-weighted against BSDF sampling, unoccluded or zero.
+    /// One vertex of `path`, where its ray met `hit` (or escaped): emission, the light
+    /// sample, and the next ray by sampling the BSDF. The light sample's shadow ray is left
+    /// to the caller ([`PathState::add_light`] once it is answered). False when the path ends.
+    #[inline(always)]
+    fn vertex(
+        &self,
+        shading: &ShadingScene,
+        path: &mut PathState,
+        hit: Option<Hit>,
+        dims: &mut impl SampleDims,
+    ) -> (Option<Shadow>, bool) {
+        let light_select = shading.light_select_pdf();
+        let d_world = path.ray.direction.to_glam();
+        // Escaped rays see the environment.
+        let Some(hit) = hit else {
+            for &i in &shading.environment {
+                let Light::Environment(env) = &shading.lights[i as usize] else {
+                    continue;
+                };
+                let (le, weight) = if path.specular_bounce {
+                    (env.radiance(d_world), 1.0)
+                } else {
+                    let (le, pdf) = env.radiance_and_pdf(d_world);
+                    (le, power_heuristic(path.prev_pdf, light_select * pdf))
+                };
+                path.radiance += path.beta * le * weight;
+            }
+            return (None, false);
+        };
+        path.camera_ray_hit |= path.depth == 0;
+        let wo_world = -d_world;
+        let n_geometric = hit.n_geometric.to_glam();
+
+        // Emission of the surface hit, weighted against light sampling's chance of it.
+        if let Some(area) = shading.area_light(hit.instance) {
+            let le = area.emitted(n_geometric, wo_world);
+            if le != Vec3::ZERO {
+                let weight = if path.specular_bounce {
+                    1.0
+                } else {
+                    let pdf_light = light_select
+                        * area.pdf_li(
+                            path.prev_p,
+                            hit.p.to_glam(),
+                            n_geometric,
+                            hit.primitive,
+                            hit.time,
+                        );
+                    power_heuristic(path.prev_pdf, pdf_light)
+                };
+                path.radiance += path.beta * le * weight;
+            }
+        }
+        if path.depth >= self.max_depth {
+            return (None, false);
+        }
+        let Some(material) = shading.material(hit.instance) else {
+            return (None, false);
+        };
+
+        // The shading frame: two-sided materials face the viewer; glass keeps its side.
+        let frame = shading_frame(&hit, material, wo_world);
+        let wo = frame.to_local(wo_world);
+        if wo.z == 0.0 {
+            return (None, false);
+        }
+
+        // Next-event estimation: one light, chosen uniformly.
+        let mut shadow = None;
+        if !material.is_specular() && !shading.lights.is_empty() {
+            // With one light there is nothing to choose: the number is skipped, not drawn.
+            let u_light = dims.next_1d_if(shading.lights.len() > 1);
+            let u2_light = dims.next_2d();
+            match self.sample_light(shading, &hit, material, &frame, wo, u_light, u2_light) {
+                Some((value, ray)) => {
+                    shadow = Some(Shadow {
+                        beta: path.beta,
+                        value,
+                        ray,
+                    });
+                }
+                None => path.radiance += path.beta * Vec3::ZERO,
+            }
+        }
+
+        // Continue the path by sampling the BSDF.
+        // Only a material with a choice of lobes reads `u` (see Material::reads_lobe_choice).
+        let u = dims.next_1d_if(material.reads_lobe_choice());
+        let u2 = dims.next_2d();
+        let Some(bs) = material.sample(wo, u, u2) else {
+            return (shadow, false);
+        };
+        if bs.pdf < MIN_PDF || bs.f == Vec3::ZERO {
+            return (shadow, false);
+        }
+        let throughput = bs.f * bs.wi.z.abs() / bs.pdf;
+        if !throughput.is_finite() {
+            return (shadow, false);
+        }
+        path.beta *= throughput;
+        path.specular_bounce = bs.specular;
+        path.prev_pdf = bs.pdf;
+        path.prev_p = hit.p.to_glam();
+        let Some(wi_world) = frame.from_local(bs.wi).try_normalize() else {
+            return (shadow, false);
+        };
+        path.ray = spawn_ray(&hit, wi_world);
+        path.depth += 1;
+
+        path.eta_scale *= bs.eta * bs.eta;
+        // Russian roulette once the path is a few bounces long.
+        if path.depth >= Self::RR_START_DEPTH {
+            let survive = rr_survival(path.beta, path.eta_scale);
+            if dims.next_1d() >= survive {
+                return (shadow, false);
+            }
+            path.beta /= survive;
+        }
+        (shadow, true)
+    }
+
+    /// One light sample at `hit`, MIS-weighted against BSDF sampling: its value if nothing
+    /// blocks it, and the shadow ray that decides that; `None` for a sample worth nothing.
     fn sample_light(
         &self,
-        geometry: &Scene,
         shading: &ShadingScene,
         hit: &Hit,
         material: &Material,
@@ -384,38 +461,91 @@ impl PathIntegrator {
         wo: Vec3,
         u_light: f32,
         u2_light: Vec2,
-    ) -> Vec3 {
+    ) -> Option<(Vec3, Ray<World>)> {
         let count = shading.lights.len();
         let index = ((u_light * count as f32) as usize).min(count - 1);
         let light_select = 1.0 / count as f32;
         let p = hit.p.to_glam();
-        let Some(ls) = shading.lights[index].sample_li(p, hit.time, u2_light) else {
-            return Vec3::ZERO;
-        };
+        let ls = shading.lights[index].sample_li(p, hit.time, u2_light)?;
         if ls.radiance == Vec3::ZERO || (!ls.delta && ls.pdf < MIN_PDF) {
-            return Vec3::ZERO;
+            return None;
         }
         let wi = frame.to_local(ls.wi);
         let f = material.eval(wo, wi) * wi.z.abs();
         if f == Vec3::ZERO {
-            return Vec3::ZERO;
+            return None;
         }
         // Shadow ray at the path's own time, so moving occluders cast moving shadows.
         let shadow = match ls.p_light {
             Some(p_light) => spawn_ray_to(hit, p_light),
             None => spawn_ray(hit, ls.wi),
         };
-        if geometry.occluded(&shadow) {
-            return Vec3::ZERO;
-        }
-        if ls.delta {
+        let value = if ls.delta {
             f * ls.radiance / light_select
         } else {
             let pdf_light = light_select * ls.pdf;
             let weight = power_heuristic(pdf_light, material.pdf(wo, wi));
             f * ls.radiance * weight / pdf_light
-        }
+        };
+        Some((value, shadow))
     }
+}
+
+/// A path under way: its next ray, throughput and radiance so far, and what MIS needs of the
+/// previous scattering.
+#[derive(Clone, Copy, Debug)]
+struct PathState {
+    ray: Ray<World>,
+    beta: Vec3,
+    radiance: Vec3,
+    /// Whether the previous scattering was a delta lobe, its pdf, and where it happened.
+    specular_bounce: bool,
+    prev_pdf: f32,
+    prev_p: Vec3,
+    depth: u32,
+    /// The product of eta^2 over the refractions so far: beta * eta_scale is the path's
+    /// throughput without the 1 / eta^2 radiance scaling, which Russian roulette must not see.
+    eta_scale: f32,
+    camera_ray_hit: bool,
+}
+
+impl PathState {
+    /// A path starting along `camera_ray`; `None` for a direction that cannot be normalised.
+    fn new(camera_ray: &Ray<World>) -> Option<PathState> {
+        let mut ray = *camera_ray;
+        let dir = ray.direction.to_glam().try_normalize()?;
+        ray.direction = Vector3::from_glam(dir);
+        Some(PathState {
+            ray,
+            beta: Vec3::ONE,
+            radiance: Vec3::ZERO,
+            specular_bounce: true,
+            prev_pdf: 0.0,
+            prev_p: ray.origin.to_glam(),
+            depth: 0,
+            eta_scale: 1.0,
+            camera_ray_hit: false,
+        })
+    }
+
+    /// Adds a light sample's share once its shadow ray is answered: the throughput it was
+    /// taken at times its value, or times zero when blocked (the same sum the one-path loop
+    /// has always made, NaN and infinity included).
+    #[inline(always)]
+    fn add_light(&mut self, shadow: Shadow, blocked: bool) {
+        let value = if blocked { Vec3::ZERO } else { shadow.value };
+        self.radiance += shadow.beta * value;
+    }
+}
+
+/// A light sample waiting for its shadow ray's answer.
+#[derive(Clone, Copy, Debug)]
+struct Shadow {
+    /// The path's throughput when the sample was taken.
+    beta: Vec3,
+    /// The sample's value if nothing blocks it.
+    value: Vec3,
+    ray: Ray<World>,
 }
 
 /// Russian roulette's survival probability for a path of throughput `beta` whose refractions
