@@ -13,7 +13,9 @@ honoured), then in this one invocation on this one machine:
 * accel: Obscura (`obscura-side`) writes each generated mesh and its ray sets (256x256 pinhole
   primary rays, 65,536 incoherent rays, 65,536 rays that miss the box) to a scratch folder and
   times its build and one-thread closest-hit (full hit record, and the preliminary hit with
-  only what rtcIntersect1 returns) and occlusion queries; Intel Embree 4 through
+  only what rtcIntersect1 returns) and occlusion queries, one ray at a time and as batches
+  (Scene::intersect_preliminary_batch, occluded_batch: an array of rays, as embreex's `run`
+  takes); Intel Embree 4 through
   `embreex` then builds the very same triangles and traces the very same rays, pinned to one
   core. embreex calls Embree one ray at a time from Cython, so its "miss" figure (rays that miss
   the root box) is printed as the per-call overhead that its other figures include.
@@ -232,6 +234,10 @@ def bench_accel(results):
                 ("closest", "closest", "closest"),
                 ("closest, ids", "preliminary", "closest"),
                 ("occluded", "occluded", "occluded"),
+                # The batch queries (Scene::intersect_preliminary_batch, occluded_batch) take
+                # an array of rays, as embreex's `run` does.
+                ("closest, ids, batch", "preliminary_batch", "closest"),
+                ("occluded, batch", "occluded_batch", "occluded"),
             ]:
                 mine, peers = ours[f"{name}_{key}_rps"], peer and peer[f"{name}_{theirs}_rps"]
                 row(f"{name} {label} (Mrays/s)", mine / 1e6, peers and peers / 1e6)

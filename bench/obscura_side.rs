@@ -5,7 +5,8 @@
 //! sets to DIR as raw little-endian arrays so the peers trace exactly the same data, then
 //! measures build time and one-thread throughput of the closest hit (the full `Hit`, and the
 //! preliminary hit: distance, ids and barycentrics, what `rtcIntersect1` returns) and of
-//! occlusion, and prints one JSON object on stdout. Run by hand, never by the test suite.
+//! occlusion, one ray at a time and in batches of 4096 (`intersect_preliminary_batch`,
+//! `occluded_batch`), and prints one JSON object on stdout. Run by hand, never by the test suite.
 
 use camera_obscura::accel::{Placement, Scene, SceneBuilder, Shape, TriangleMesh};
 use camera_obscura::space::{Point3, Ray, Transform, Vector3, World};
@@ -74,9 +75,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let closest = rate(rays, |r| scene.intersect(r).is_some());
         let occluded = rate(rays, |r| scene.occluded(r));
         let preliminary = rate(rays, |r| scene.intersect_preliminary(r).is_some());
+        let batch = rate_batch(rays, |rs| {
+            scene
+                .intersect_preliminary_batch(rs)
+                .iter()
+                .filter(|h| h.is_some())
+                .count()
+        });
+        let occluded_batch = rate_batch(rays, |rs| {
+            scene.occluded_batch(rs).iter().filter(|&&o| o).count()
+        });
         let hits = rays.iter().filter(|r| scene.intersect(r).is_some()).count();
         out += &format!(
-            ", \"{name}_closest_rps\": {closest:.1}, \"{name}_preliminary_rps\": {preliminary:.1}, \"{name}_occluded_rps\": {occluded:.1}, \"{name}_hits\": {hits}"
+            ", \"{name}_closest_rps\": {closest:.1}, \"{name}_preliminary_rps\": {preliminary:.1}, \"{name}_preliminary_batch_rps\": {batch:.1}, \"{name}_occluded_rps\": {occluded:.1}, \"{name}_occluded_batch_rps\": {occluded_batch:.1}, \"{name}_hits\": {hits}"
         );
     }
     out += "}";
@@ -101,6 +112,18 @@ fn rate(rays: &[Ray<World>], mut query: impl FnMut(&Ray<World>) -> bool) -> f64 
     for _ in 0..5 {
         let start = Instant::now();
         let n = rays.iter().filter(|r| query(r)).count();
+        black_box(n);
+        best = best.min(start.elapsed().as_secs_f64());
+    }
+    rays.len() as f64 / best
+}
+
+/// Rays per second of a batch query, best of five passes over the set in batches of 4096.
+fn rate_batch(rays: &[Ray<World>], mut query: impl FnMut(&[Ray<World>]) -> usize) -> f64 {
+    let mut best = f64::INFINITY;
+    for _ in 0..5 {
+        let start = Instant::now();
+        let n: usize = rays.chunks(4096).map(&mut query).sum();
         black_box(n);
         best = best.min(start.elapsed().as_secs_f64());
     }

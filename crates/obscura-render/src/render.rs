@@ -302,7 +302,8 @@ fn render_tile(
     // tile's sums are the same as one pixel after another would make them.
     let mut streams = Vec::with_capacity(tile.area() as usize);
     let mut rays = Vec::with_capacity(tile.area() as usize);
-    // Each pixel's film position, and its camera ray's weight and index in `rays`.
+    // Each pixel's film position and its camera ray's weight (`None`: no ray); the rays
+    // themselves are in `rays`, in the same order.
     let mut samples = Vec::with_capacity(tile.area() as usize);
     for y in tile.y0..tile.y1 {
         for x in tile.x0..tile.x1 {
