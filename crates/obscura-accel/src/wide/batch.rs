@@ -35,78 +35,106 @@ pub(crate) struct BatchRay {
     pub t_max: f32,
 }
 
+/// A query that can take turns with others ([`WideBvh::run`]).
+pub(super) trait InTurns: Sized {
+    /// What the query answers for a ray.
+    type Answer;
+    /// An entry of its traversal stack.
+    type Entry;
+    /// The query of a ray with `t_min >= 0` from the tree's root.
+    fn new(root: u32, r: &BatchRay) -> Self;
+    /// The ray's query, or its answer at once from the one-ray query: a ray that may start
+    /// behind its origin has the other box test, so it takes the one-ray query.
+    fn start(bvh: &WideBvh, r: &BatchRay) -> Result<Self, Self::Answer> {
+        if r.t_min >= 0.0 {
+            Ok(Self::new(bvh.root, r))
+        } else {
+            Err(Self::one(bvh, r))
+        }
+    }
+    /// The one-ray query's answer.
+    fn one(bvh: &WideBvh, r: &BatchRay) -> Self::Answer;
+    /// One step; the answer once the query has one.
+    fn advance(
+        &mut self,
+        nodes: &[Node],
+        packets: &[Packet],
+        stack: &mut Vec<Self::Entry>,
+    ) -> Option<Self::Answer>;
+    /// The node or packet the query visits next.
+    fn at(&self) -> u32;
+}
+
+impl InTurns for Closest<false> {
+    type Answer = Option<WideHit>;
+    type Entry = (u32, f32);
+    fn new(root: u32, r: &BatchRay) -> Self {
+        Closest::new(root, r.o, r.d, r.t_min, r.t_max)
+    }
+    fn one(bvh: &WideBvh, r: &BatchRay) -> Self::Answer {
+        bvh.closest(r.o, r.d, r.t_min, r.t_max)
+    }
+    fn advance(
+        &mut self,
+        nodes: &[Node],
+        packets: &[Packet],
+        stack: &mut Vec<Self::Entry>,
+    ) -> Option<Self::Answer> {
+        (!self.step::<false>(nodes, packets, stack, &mut 0)).then(|| self.hit(packets))
+    }
+    fn at(&self) -> u32 {
+        self.current
+    }
+}
+
+impl InTurns for Any<false> {
+    type Answer = bool;
+    type Entry = u32;
+    fn new(root: u32, r: &BatchRay) -> Self {
+        Any::new(root, r.o, r.d, r.t_min, r.t_max)
+    }
+    fn one(bvh: &WideBvh, r: &BatchRay) -> Self::Answer {
+        bvh.any(r.o, r.d, r.t_min, r.t_max)
+    }
+    fn advance(
+        &mut self,
+        nodes: &[Node],
+        packets: &[Packet],
+        stack: &mut Vec<Self::Entry>,
+    ) -> Option<Self::Answer> {
+        match self.step::<false>(nodes, packets, stack, &mut 0) {
+            Step::Next => None,
+            Step::Hit => Some(true),
+            Step::Done => Some(false),
+        }
+    }
+    fn at(&self) -> u32 {
+        self.current
+    }
+}
+
 impl WideBvh {
     /// The closest hit of each ray, `out[i]` for `rays[i]`, each exactly as
     /// [`closest`](WideBvh::closest) finds it. `out` is as long as `rays`.
     pub(crate) fn closest_batch(&self, rays: &[BatchRay], out: &mut [Option<WideHit>]) {
-        if self.interleaves() {
-            self.closest_interleaved(rays, out);
-        } else {
-            for (r, o) in rays.iter().zip(out) {
-                *o = self.closest(r.o, r.d, r.t_min, r.t_max);
-            }
-        }
-    }
-
-    /// [`closest_batch`](WideBvh::closest_batch) taking turns between rays, whatever the
-    /// tree's size.
-    pub(super) fn closest_interleaved(&self, rays: &[BatchRay], out: &mut [Option<WideHit>]) {
-        let packets = &*self.packets;
-        self.run(
-            rays,
-            out,
-            |r| {
-                // A ray that may start behind its origin has the other box test: it takes the
-                // one-ray query.
-                if r.t_min >= 0.0 {
-                    Ok(Closest::<false>::new(self.root, r.o, r.d, r.t_min, r.t_max))
-                } else {
-                    Err(self.closest(r.o, r.d, r.t_min, r.t_max))
-                }
-            },
-            |q, nodes, stack| {
-                if q.step::<false>(nodes, packets, stack, &mut 0) {
-                    None
-                } else {
-                    Some(q.hit(packets))
-                }
-            },
-            |q| q.current,
-        );
+        self.batch::<Closest<false>>(rays, out);
     }
 
     /// Whether each ray hits anything, `out[i]` for `rays[i]`, each exactly as
     /// [`any`](WideBvh::any) answers it. `out` is as long as `rays`.
     pub(crate) fn any_batch(&self, rays: &[BatchRay], out: &mut [bool]) {
-        if self.interleaves() {
-            self.any_interleaved(rays, out);
-        } else {
-            for (r, o) in rays.iter().zip(out) {
-                *o = self.any(r.o, r.d, r.t_min, r.t_max);
-            }
-        }
+        self.batch::<Any<false>>(rays, out);
     }
 
-    /// [`any_batch`](WideBvh::any_batch) taking turns between rays, whatever the tree's size.
-    pub(super) fn any_interleaved(&self, rays: &[BatchRay], out: &mut [bool]) {
-        let packets = &*self.packets;
-        self.run(
-            rays,
-            out,
-            |r| {
-                if r.t_min >= 0.0 {
-                    Ok(Any::<false>::new(self.root, r.o, r.d, r.t_min, r.t_max))
-                } else {
-                    Err(self.any(r.o, r.d, r.t_min, r.t_max))
-                }
-            },
-            |q, nodes, stack| match q.step::<false>(nodes, packets, stack, &mut 0) {
-                Step::Next => None,
-                Step::Hit => Some(true),
-                Step::Done => Some(false),
-            },
-            |q| q.current,
-        );
+    /// In turns on a large tree, one ray after another on a small one.
+    fn batch<Q: InTurns>(&self, rays: &[BatchRay], out: &mut [Q::Answer]) {
+        if self.interleaves() {
+            self.run::<Q>(rays, out);
+        } else {
+            for (r, o) in rays.iter().zip(out) {
+                *o = Q::one(self, r);
+            }
+        }
     }
 
     /// Whether a batch takes turns between rays: only for a tree too large for the caches
@@ -117,26 +145,19 @@ impl WideBvh {
         self.heap_bytes() >= INTERLEAVE_MIN_BYTES
     }
 
-    /// The batch loop: `start` makes a ray's query (or answers it at once), `advance` takes
-    /// one step of a query and gives its answer when it has one, `at` names what a query
-    /// visits next.
+    /// The batch loop, in turns whatever the tree's size: each ray's query starts
+    /// ([`InTurns::start`]), steps and asks for its next node's lines in turn with the others,
+    /// and hands its lane to the next ray when it has its answer.
     #[inline(always)]
-    fn run<Q, E, T>(
-        &self,
-        rays: &[BatchRay],
-        out: &mut [T],
-        start: impl Fn(&BatchRay) -> Result<Q, T>,
-        advance: impl Fn(&mut Q, &[Node], &mut Vec<E>) -> Option<T>,
-        at: impl Fn(&Q) -> u32,
-    ) {
+    pub(super) fn run<Q: InTurns>(&self, rays: &[BatchRay], out: &mut [Q::Answer]) {
         let (nodes, packets) = (&*self.nodes, &*self.packets);
-        let mut flights: Vec<(Q, usize, Vec<E>)> = Vec::with_capacity(LANES);
-        let mut stacks: Vec<Vec<E>> = Vec::with_capacity(LANES);
+        let mut flights: Vec<(Q, usize, Vec<Q::Entry>)> = Vec::with_capacity(LANES);
+        let mut stacks: Vec<Vec<Q::Entry>> = Vec::with_capacity(LANES);
         let mut slots = 0..rays.len().min(out.len());
         // The next ray that needs a traversal, answering the others on the way.
-        let mut next = |stacks: &mut Vec<Vec<E>>, out: &mut [T]| {
+        let mut next = |stacks: &mut Vec<Vec<Q::Entry>>, out: &mut [Q::Answer]| {
             for slot in slots.by_ref() {
-                match start(&rays[slot]) {
+                match Q::start(self, &rays[slot]) {
                     Ok(q) => {
                         let mut stack = stacks.pop().unwrap_or_default();
                         stack.clear();
@@ -157,8 +178,8 @@ impl WideBvh {
             let mut i = 0;
             while i < flights.len() {
                 let (q, slot, stack) = &mut flights[i];
-                let Some(answer) = advance(q, nodes, stack) else {
-                    ask(nodes, packets, at(q));
+                let Some(answer) = q.advance(nodes, packets, stack) else {
+                    ask(nodes, packets, q.at());
                     i += 1;
                     continue;
                 };

@@ -338,8 +338,8 @@ fn interleaved_batches_answer_as_one_ray_queries() {
             let rays = &rays[..len];
             let mut closest = vec![None; len];
             let mut any = vec![false; len];
-            bvh.closest_interleaved(rays, &mut closest);
-            bvh.any_interleaved(rays, &mut any);
+            bvh.run::<super::traverse::Closest<false>>(rays, &mut closest);
+            bvh.run::<super::traverse::Any<false>>(rays, &mut any);
             for (k, r) in rays.iter().enumerate() {
                 let one = bvh.closest(r.o, r.d, r.t_min, r.t_max);
                 let key = |h: &super::WideHit| {

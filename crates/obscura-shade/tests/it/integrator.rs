@@ -393,18 +393,16 @@ fn a_moving_occluder_casts_a_moving_shadow() {
     assert!((fraction - 0.25).abs() < 0.031, "{fraction}");
 }
 
-#[test]
-fn radiance_is_always_finite() {
-    // Every material and light together, rays in every direction, grazing included.
+/// Every material and light together: `ground` under a glass, a mirror and an emitting
+/// sphere, an emitting quad of a smooth conductor, a point light, a distant light and a sky
+/// with one very bright texel.
+fn every_material_and_light(ground: (Shape, Placement, Material, Vec3)) -> (Scene, ShadingScene) {
     let mut texels = vec![Vec3::splat(0.5); 8 * 4];
     texels[5] = Vec3::splat(1e4);
     let env = EnvironmentLight::from_texels(8, 4, texels, glam::Mat4::IDENTITY).unwrap();
-    let scene = build(
+    build(
         vec![
-            floor(Material::RoughConductor {
-                reflectance: Vec3::splat(0.9),
-                roughness: 0.3,
-            }),
+            ground,
             (
                 Shape::Sphere {
                     center: Vec3::new(0.0, 1.0, 0.0),
@@ -453,7 +451,16 @@ fn radiance_is_always_finite() {
             Light::distant(Vec3::new(1.0, -1.0, 0.0), Vec3::ONE).unwrap(),
             Light::Environment(env),
         ],
-    );
+    )
+}
+
+#[test]
+fn radiance_is_always_finite() {
+    // Every material and light together, rays in every direction, grazing included.
+    let scene = every_material_and_light(floor(Material::RoughConductor {
+        reflectance: Vec3::splat(0.9),
+        roughness: 0.3,
+    }));
     let integrator = PathIntegrator::new(12);
     let mut rng = Rng::new(31);
     for _ in 0..3000 {
@@ -651,61 +658,16 @@ fn rippled_floor(n: u32, material: Material) -> (Shape, Placement, Material, Vec
 fn paths_traced_together_equal_paths_traced_one_by_one() {
     // The batch (wavefront) path tracer must give every camera ray the very value the one-path
     // loop gives it, bit for bit: the same numbers drawn in the same order, the same sums. A
-    // floor of 80,000 triangles makes the geometry's batches take turns between rays; glass,
-    // a mirror, an emitting quad and sphere, a point light and a bright texel of the sky
-    // exercise every branch of a vertex (escape, emission with MIS, delta and area light
-    // samples, occlusion, roulette).
-    let mut texels = vec![Vec3::splat(0.5); 8 * 4];
-    texels[5] = Vec3::splat(50.0);
-    let env = EnvironmentLight::from_texels(8, 4, texels, glam::Mat4::IDENTITY).unwrap();
-    let scene = build(
-        vec![
-            rippled_floor(200, white()),
-            (
-                Shape::Sphere {
-                    center: Vec3::new(0.0, 1.0, 0.0),
-                    radius: 1.0,
-                },
-                fixed(),
-                Material::Dielectric { ior: 1.5 },
-                Vec3::ZERO,
-            ),
-            (
-                Shape::Sphere {
-                    center: Vec3::new(2.5, 1.0, 0.0),
-                    radius: 1.0,
-                },
-                fixed(),
-                Material::Mirror {
-                    reflectance: Vec3::splat(0.9),
-                },
-                Vec3::ZERO,
-            ),
-            (
-                Shape::Sphere {
-                    center: Vec3::new(-2.5, 1.0, 0.0),
-                    radius: 0.7,
-                },
-                fixed(),
-                white(),
-                Vec3::splat(3.0),
-            ),
-            (
-                Shape::Quad {
-                    origin: Vec3::new(-1.0, 4.0, -1.0),
-                    edge_u: Vec3::new(2.0, 0.0, 0.0),
-                    edge_v: Vec3::new(0.0, 0.0, 2.0),
-                },
-                fixed(),
-                white(),
-                Vec3::splat(5.0),
-            ),
-        ],
-        vec![
-            Light::point(Vec3::new(0.0, 3.0, 2.0), Vec3::splat(5.0)).unwrap(),
-            Light::Environment(env),
-        ],
-    );
+    // floor of 80,000 triangles makes the geometry's batches take turns between rays; every
+    // material and light exercises every branch of a vertex (escape, emission with MIS,
+    // delta and area light samples, occlusion, roulette).
+    let scene = every_material_and_light(rippled_floor(
+        200,
+        Material::RoughConductor {
+            reflectance: Vec3::splat(0.9),
+            roughness: 0.3,
+        },
+    ));
     assert!(scene.0.batches(), "the floor is large enough for batches");
     let integrator = PathIntegrator::new(12);
     let mut rng = Rng::new(7);
