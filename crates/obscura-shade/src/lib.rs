@@ -15,6 +15,9 @@
 //!   importance sampling ([`power_heuristic`]) and Russian roulette, over an
 //!   `obscura_accel::Scene` and a [`ShadingScene`] (materials per instance, lights). It draws
 //!   its random numbers from any [`SampleDims`], such as `obscura_sample::SampleStream`.
+//!   [`PathIntegrator::li_and_hit_batch`] traces many camera rays' paths together, a vertex
+//!   each per round, so that their rays reach the geometry in batches (faster on large
+//!   meshes, the same values bit for bit).
 //!
 //! What is not here: geometry and ray queries (obscura-accel), cameras, films, scene files and
 //! image output (obscura-camera, obscura-render). Nothing here owns a random number generator.
