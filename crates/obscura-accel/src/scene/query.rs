@@ -121,12 +121,14 @@ impl Scene {
     /// Whether the batch queries ([`intersect_batch`](Scene::intersect_batch),
     /// [`occluded_batch`](Scene::occluded_batch)) can be faster than one ray at a time here:
     /// only the static triangles' BVH is traversed in turns, and only when it is too large
-    /// for the caches nearest the core (a few MB: about 40,000 triangles or more). Spheres,
-    /// quads, moving meshes and small meshes are answered one ray at a time either way, so a
-    /// caller that would gather rays just for the batch need not when this is false. The
-    /// answers are the same either way.
+    /// for the caches nearest the core (a few MB: about 40,000 triangles or more) and the
+    /// scene has at most eight items besides (more go through obvhs's top-level tree, one ray
+    /// at a time). Spheres, quads, moving meshes and small meshes are answered one ray at a
+    /// time either way, so a caller that would gather rays just for the batch need not when
+    /// this is false. The answers are the same either way.
     pub fn batches(&self) -> bool {
-        self.flat.as_ref().is_some_and(WideBvh::interleaves)
+        matches!(self.tlas, Top::One | Top::Few { sorted: true, .. })
+            && self.flat.as_ref().is_some_and(WideBvh::interleaves)
     }
 
     /// The closest hit of each ray in `rays`, in order: the same as [`intersect`](Scene::intersect)
