@@ -3,7 +3,9 @@
 //!
 //! `cargo bench -p obscura-accel -- --quick`. Throughput is reported in rays (elements) per
 //! second: coherent primary rays from a pinhole grid, incoherent rays between random points,
-//! each as a closest-hit query and as a shadow (any-hit) query. `bench/compare.py` traces the
+//! each as a closest-hit query and as a shadow (any-hit) query, one ray at a time and in
+//! batches of 4096 (`Scene::intersect_preliminary_batch`, `occluded_batch`; their turns
+//! between rays pay on the 1M-triangle meshes). `bench/compare.py` traces the
 //! same kinds of rays through Embree for the ratios in docs/performance.md.
 
 // criterion_group! generates an undocumented function.
@@ -77,6 +79,24 @@ fn bench(c: &mut Criterion) {
             });
             trace.bench_function(format!("{name}_shadow_anyhit"), |b| {
                 b.iter(|| rays.iter().filter(|r| scene.occluded(r)).count())
+            });
+            // The batch queries, over the same rays in batches of 4096.
+            trace.bench_function(format!("{name}_closest_preliminary_batch"), |b| {
+                b.iter(|| {
+                    rays.chunks(4096)
+                        .map(|rs| {
+                            let hits = scene.intersect_preliminary_batch(rs);
+                            hits.iter().filter(|h| h.is_some()).count()
+                        })
+                        .sum::<usize>()
+                })
+            });
+            trace.bench_function(format!("{name}_shadow_anyhit_batch"), |b| {
+                b.iter(|| {
+                    rays.chunks(4096)
+                        .map(|rs| scene.occluded_batch(rs).iter().filter(|&&o| o).count())
+                        .sum::<usize>()
+                })
             });
         }
         trace.finish();
