@@ -306,6 +306,7 @@ impl PathIntegrator {
         out
     }
 
+    #[inline(always)]
     fn trace(
         &self,
         geometry: &Scene,
@@ -452,6 +453,7 @@ impl PathIntegrator {
 
     /// One light sample at `hit`, MIS-weighted against BSDF sampling: its value if nothing
     /// blocks it, and the shadow ray that decides that; `None` for a sample worth nothing.
+    #[inline(always)]
     fn sample_light(
         &self,
         shading: &ShadingScene,
