@@ -127,8 +127,16 @@ impl Scene {
     /// time either way, so a caller that would gather rays just for the batch need not when
     /// this is false. The answers are the same either way.
     pub fn batches(&self) -> bool {
-        matches!(self.tlas, Top::One | Top::Few { sorted: true, .. })
-            && self.flat.as_ref().is_some_and(WideBvh::interleaves)
+        self.pausable_flat().is_some_and(WideBvh::interleaves)
+    }
+
+    /// The flattened triangles' BVH when a ray's walk over the top level can pause at it
+    /// (no top level, or a few boxes visited nearest first), as the batch queries need.
+    fn pausable_flat(&self) -> Option<&WideBvh> {
+        match self.tlas {
+            Top::One | Top::Few { sorted: true, .. } => self.flat.as_ref(),
+            Top::Few { sorted: false, .. } | Top::Two(_) | Top::Tree(..) => None,
+        }
     }
 
     /// The closest hit of each ray in `rays`, in order: the same as [`intersect`](Scene::intersect)
@@ -166,106 +174,88 @@ impl Scene {
     /// ([`WideBvh::closest_batch`]) before each goes on with the items after it.
     fn found_batch(&self, rays: &[Ray<World>]) -> Vec<Option<(PlainRay, Found)>> {
         let plain = rays.iter().map(PlainRay::new);
-        let Some(flat) = self.flat.as_ref() else {
+        let Some(flat) = self.pausable_flat() else {
             return plain
                 .map(|r| r.and_then(|r| Some((r, self.found(&r)?))))
                 .collect();
         };
-        match &self.tlas {
-            Top::One if self.items.len() == 1 => {
-                let plain: Vec<Option<PlainRay>> = plain.collect();
-                let batch: Vec<BatchRay> = plain.iter().flatten().map(BatchRay::from).collect();
-                let mut hits = vec![None; batch.len()];
-                flat.closest_batch(&batch, &mut hits);
-                let mut hits = hits.into_iter();
-                plain
-                    .into_iter()
-                    .map(|r| {
-                        let r = r?;
-                        let hit = hits.next().flatten()?;
-                        Some((r, Found::Flat { hit }))
-                    })
-                    .collect()
-            }
-            Top::Few { set, sorted: true } => {
-                // Each ray's walk over the boxes it enters, nearest first, as in `found`:
-                // up to the flattened triangles, then (after the batch) on from there.
-                struct Walk {
-                    r: PlainRay,
-                    entered: [(usize, f32); BoxSet::CAPACITY],
-                    n: usize,
-                    next: usize,
-                    best: Option<Found>,
-                    t_best: f32,
-                }
-                let walk = |w: &mut Walk| -> bool {
-                    while w.next < w.n {
-                        let (item, t_entry) = w.entered[w.next];
-                        if t_entry > w.t_best {
-                            w.next = w.n;
-                            break;
-                        }
-                        if matches!(self.items[item], Item::Flat) {
-                            return true;
-                        }
-                        w.next += 1;
-                        if let Some(f) = self.intersect_item(item, &w.r, w.t_best) {
-                            w.t_best = f.t();
-                            w.best = Some(f);
-                        }
-                    }
-                    false
-                };
-                let mut walks: Vec<Option<Walk>> = plain
-                    .map(|r| {
-                        let r = r?;
-                        let mut entered = [(0, 0.0); BoxSet::CAPACITY];
-                        let n = set.entered(r.o, r.d, r.t_min, r.t_max, &mut entered);
-                        Some(Walk {
-                            r,
-                            entered,
-                            n,
-                            next: 0,
-                            best: None,
-                            t_best: r.t_max,
-                        })
-                    })
-                    .collect();
-                let mut waiting = Vec::new();
-                let mut batch = Vec::new();
-                for (k, w) in walks.iter_mut().enumerate() {
-                    if let Some(w) = w
-                        && walk(w)
-                    {
-                        waiting.push(k);
-                        batch.push(BatchRay {
-                            t_max: w.t_best,
-                            ..BatchRay::from(&w.r)
-                        });
-                    }
-                }
-                let mut hits = vec![None; batch.len()];
-                flat.closest_batch(&batch, &mut hits);
-                for (k, hit) in waiting.into_iter().zip(hits) {
-                    if let Some(w) = &mut walks[k] {
-                        w.next += 1;
-                        if let Some(hit) = hit {
-                            w.t_best = hit.tri.t;
-                            w.best = Some(Found::Flat { hit });
-                        }
-                        // One flat item only: the rest of the walk needs no batch.
-                        walk(w);
-                    }
-                }
-                walks
-                    .into_iter()
-                    .map(|w| w.and_then(|w| Some((w.r, w.best?))))
-                    .collect()
-            }
-            _ => plain
-                .map(|r| r.and_then(|r| Some((r, self.found(&r)?))))
-                .collect(),
+        // Each ray's walk over the items it enters, as in `found`: nearest first under a few
+        // boxes, the one item (the flattened triangles) with no top level. It runs up to the
+        // flattened triangles and, after the batch, on from there.
+        struct Walk {
+            r: PlainRay,
+            entered: [(usize, f32); BoxSet::CAPACITY],
+            n: usize,
+            next: usize,
+            best: Option<Found>,
+            t_best: f32,
         }
+        let walk = |w: &mut Walk| -> bool {
+            while w.next < w.n {
+                let (item, t_entry) = w.entered[w.next];
+                if t_entry > w.t_best {
+                    w.next = w.n;
+                    break;
+                }
+                if matches!(self.items[item], Item::Flat) {
+                    return true;
+                }
+                w.next += 1;
+                if let Some(f) = self.intersect_item(item, &w.r, w.t_best) {
+                    w.t_best = f.t();
+                    w.best = Some(f);
+                }
+            }
+            false
+        };
+        let mut walks: Vec<Option<Walk>> = plain
+            .map(|r| {
+                let r = r?;
+                let mut entered = [(0, r.t_min); BoxSet::CAPACITY];
+                let n = match &self.tlas {
+                    Top::Few { set, .. } => set.entered(r.o, r.d, r.t_min, r.t_max, &mut entered),
+                    _ => 1,
+                };
+                Some(Walk {
+                    r,
+                    entered,
+                    n,
+                    next: 0,
+                    best: None,
+                    t_best: r.t_max,
+                })
+            })
+            .collect();
+        let mut waiting = Vec::new();
+        let mut batch = Vec::new();
+        for (k, w) in walks.iter_mut().enumerate() {
+            if let Some(w) = w
+                && walk(w)
+            {
+                waiting.push(k);
+                batch.push(BatchRay {
+                    t_max: w.t_best,
+                    ..BatchRay::from(&w.r)
+                });
+            }
+        }
+        let mut hits = vec![None; batch.len()];
+        flat.closest_batch(&batch, &mut hits);
+        for (k, hit) in waiting.into_iter().zip(hits) {
+            if let Some(w) = &mut walks[k] {
+                w.next += 1;
+                if let Some(hit) = hit {
+                    w.t_best = hit.tri.t;
+                    w.best = Some(Found::Flat { hit });
+                }
+                // One flat item only: the rest of the walk needs no batch.
+                walk(w);
+            }
+        }
+        walks
+            .into_iter()
+            .map(|w| w.and_then(|w| Some((w.r, w.best?))))
+            .collect()
     }
 
     /// Whether anything is hit, for each ray in `rays`, in order: the same as
@@ -273,7 +263,7 @@ impl Scene {
     /// all the rays together as in [`intersect_batch`](Scene::intersect_batch) (any-hit
     /// queries visit items in no particular order, so the answer is the same).
     pub fn occluded_batch(&self, rays: &[Ray<World>]) -> Vec<bool> {
-        let Some(flat) = self.flat.as_ref() else {
+        let Some(flat) = self.pausable_flat() else {
             return rays.iter().map(|r| self.occluded(r)).collect();
         };
         let flat_lane = self.items.iter().position(|i| matches!(i, Item::Flat));
@@ -286,12 +276,8 @@ impl Scene {
                 continue;
             };
             let mask = match &self.tlas {
-                Top::One if self.items.len() == 1 => 1,
                 Top::Few { set, .. } => set.entered_mask(r.o, r.d, r.t_min, r.t_max),
-                _ => {
-                    out.push(self.occluded(ray));
-                    continue;
-                }
+                _ => 1,
             };
             let flat_bit = flat_lane.map_or(0, |lane| 1 << lane) & mask;
             let mut others = mask & !flat_bit;
