@@ -70,5 +70,6 @@ pub use error::AccelError;
 pub use hit::{Hit, SHADOW_EPSILON};
 pub use mesh::TriangleMesh;
 pub use obj::{load_obj, parse_obj};
+pub use pages::Pages;
 pub use scene::{BuildQuality, MAX_COORDINATE, PreliminaryHit, Scene, SceneBuilder};
 pub use shape::{Placement, Shape};

@@ -1,6 +1,7 @@
 //! Triangle meshes in object space.
 
 use crate::error::AccelError;
+use crate::pages::Pages;
 use glam::{Vec2, Vec3};
 use obscura_space::{Bounds3, Object, Point3};
 
@@ -12,10 +13,12 @@ use obscura_space::{Bounds3, Object, Point3};
 /// position array, and no zero-area triangle (those are dropped and counted).
 #[derive(Debug, Clone, PartialEq)]
 pub struct TriangleMesh {
-    positions: Vec<Vec3>,
-    triangles: Vec<[u32; 3]>,
-    normals: Option<Vec<Vec3>>,
-    uvs: Option<Vec<Vec2>>,
+    // On huge pages when large: a hit's record reads the triangle's indices and vertices at
+    // random (see `Pages`).
+    positions: Pages<Vec3>,
+    triangles: Pages<[u32; 3]>,
+    normals: Option<Pages<Vec3>>,
+    uvs: Option<Pages<Vec2>>,
     skipped_degenerate: usize,
     bounds: Bounds3<Object>,
 }
@@ -101,10 +104,10 @@ impl TriangleMesh {
                 .map(|&v| Point3::from_glam(positions[v as usize])),
         );
         Ok(TriangleMesh {
-            positions,
-            triangles: kept,
-            normals,
-            uvs,
+            positions: Pages::new(positions),
+            triangles: Pages::new(kept),
+            normals: normals.map(Pages::new),
+            uvs: uvs.map(Pages::new),
             skipped_degenerate,
             bounds,
         })

@@ -11,14 +11,26 @@
 //!
 //! Arrays under [`Pages::MIN_BYTES`], and every array on systems other than Linux, or where the
 //! mapping fails, stay in their `Vec`: the pages are a speed-up, never a requirement.
+//!
+//! Public, for the other large tables read at random by every ray (obscura-shade keeps an
+//! environment map's sampling grid in one).
 
 use bytemuck::Pod;
 use std::fmt;
 use std::marker::PhantomData;
 use std::ops::Deref;
 
-/// A read-only array, on huge pages where the system gives them.
-pub(crate) struct Pages<T: Pod> {
+/// A read-only array, on huge pages where the system gives them (Linux's transparent huge
+/// pages, asked for with `madvise`); read it as a slice.
+///
+/// ```
+/// use obscura_accel::Pages;
+///
+/// let table = Pages::new(vec![0u32; 1 << 20]); // 4 MiB: mapped on Linux
+/// assert_eq!(table.len(), 1 << 20);
+/// assert_eq!(table[12345], 0);
+/// ```
+pub struct Pages<T: Pod> {
     store: Store<T>,
 }
 
@@ -31,11 +43,11 @@ enum Store<T> {
 
 impl<T: Pod> Pages<T> {
     /// The smallest array worth a mapping: one huge page.
-    pub(crate) const MIN_BYTES: usize = 2 << 20;
+    pub const MIN_BYTES: usize = 2 << 20;
 
     /// `items`, moved into a mapping advised for huge pages when it is at least
     /// [`Pages::MIN_BYTES`] and the system allows; otherwise the vector itself, trimmed.
-    pub(crate) fn new(mut items: Vec<T>) -> Pages<T> {
+    pub fn new(mut items: Vec<T>) -> Pages<T> {
         if size_of_val(items.as_slice()) >= Self::MIN_BYTES
             && let Some(store) = mapped(&items)
         {
@@ -48,12 +60,12 @@ impl<T: Pod> Pages<T> {
     }
 
     /// Whether the array lives in a huge-page mapping (for tests and reports).
-    pub(crate) fn is_mapped(&self) -> bool {
+    pub fn is_mapped(&self) -> bool {
         matches!(self.store, Store::Mapped(..))
     }
 
     /// Bytes held, mapping or vector.
-    pub(crate) fn bytes(&self) -> usize {
+    pub fn bytes(&self) -> usize {
         match &self.store {
             Store::Heap(v) => v.capacity() * size_of::<T>(),
             Store::Mapped(map, _) => map.len(),
@@ -99,6 +111,12 @@ impl<T: Pod> Deref for Pages<T> {
 impl<T: Pod> Clone for Pages<T> {
     fn clone(&self) -> Self {
         Pages::new(self.to_vec())
+    }
+}
+
+impl<T: Pod + PartialEq> PartialEq for Pages<T> {
+    fn eq(&self, other: &Self) -> bool {
+        **self == **other
     }
 }
 

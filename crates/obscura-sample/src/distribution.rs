@@ -2,7 +2,8 @@
 //! environment maps and choosing triangles by area.
 
 use crate::hash::ONE_MINUS_EPSILON;
-use glam::Vec2;
+use glam::{Vec2, Vec3};
+use std::ops::Deref;
 
 /// A piecewise-constant density over `[0, 1)` with `n` equal bins of non-negative weights.
 /// When every weight is zero it falls back to the uniform density (so sampling never fails).
@@ -12,9 +13,8 @@ use glam::Vec2;
 /// about two entries instead of binary-searching all `n + 1`. The answer is exactly the full
 /// binary search's.
 ///
-/// Each bin can carry a value `V` (an environment map's texel beside its weight), kept in the
-/// same cell as the bin's CDF entry and weight: finding a bin, its density and its value
-/// touches one place in memory, which is what a large map's sampling waits on.
+/// Each bin can carry a value `V`, kept in the same cell as the bin's CDF entry and weight:
+/// finding a bin, its density and its value touches one place in memory.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Distribution1D<V = ()> {
     /// `n + 1` cells: cell `i` holds the CDF where bin `i` starts, the bin's weight (0 in the
@@ -28,10 +28,201 @@ pub struct Distribution1D<V = ()> {
 struct Cell<V> {
     cdf: f32,
     func: f32,
-    /// How many CDF entries fall in guide buckets below this cell's index (see
-    /// [`Distribution1D::bucket`]).
+    /// How many CDF entries fall in guide buckets below this cell's index (see [`bucket`]).
     guide: u32,
     value: V,
+}
+
+/// One bin of a [`Distribution2D`]'s grid as stored: the bin's CDF entry within its row, its
+/// weight, its guide entry and the RGB value it carries, 24 bytes in one place. Opaque; it is
+/// public so that a caller can choose where a large grid lives
+/// ([`Distribution2D::with_values_stored`]), and plain bytes (`bytemuck::Pod`) so that the
+/// storage may be any memory.
+#[derive(Debug, Clone, Copy, PartialEq, Default, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C)]
+pub struct GridCell {
+    cdf: f32,
+    func: f32,
+    guide: u32,
+    value: [f32; 3],
+}
+
+/// What the searches read of a cell, whichever kind it is.
+trait Bin: Copy {
+    fn cdf(&self) -> f32;
+    fn func(&self) -> f32;
+    fn guide(&self) -> u32;
+}
+
+impl<V: Copy> Bin for Cell<V> {
+    #[inline(always)]
+    fn cdf(&self) -> f32 {
+        self.cdf
+    }
+    #[inline(always)]
+    fn func(&self) -> f32 {
+        self.func
+    }
+    #[inline(always)]
+    fn guide(&self) -> u32 {
+        self.guide
+    }
+}
+
+impl Bin for GridCell {
+    #[inline(always)]
+    fn cdf(&self) -> f32 {
+        self.cdf
+    }
+    #[inline(always)]
+    fn func(&self) -> f32 {
+        self.func
+    }
+    #[inline(always)]
+    fn guide(&self) -> u32 {
+        self.guide
+    }
+}
+
+/// A 1D distribution's `n + 1` cells as built: CDF entry, weight and guide entry of each,
+/// and the weights' integral (see [`Distribution1D`]).
+fn build_bins(weights: &[f32]) -> (Vec<(f32, f32, u32)>, f32) {
+    let mut func: Vec<f32> = weights
+        .iter()
+        .map(|&w| if w.is_finite() && w > 0.0 { w } else { 0.0 })
+        .collect();
+    if func.is_empty() {
+        func.push(1.0);
+    }
+    let n = func.len();
+    // Running sums in f64 so long rows do not lose their small bins.
+    let mut cdf = Vec::with_capacity(n + 1);
+    let mut sum = 0.0f64;
+    cdf.push(0.0f32);
+    for &f in &func {
+        sum += f64::from(f) / n as f64;
+        cdf.push(sum as f32);
+    }
+    let integral = sum as f32;
+    if integral > 0.0 {
+        for c in cdf.iter_mut().skip(1) {
+            *c /= integral;
+        }
+    } else {
+        for (i, c) in cdf.iter_mut().enumerate() {
+            *c = i as f32 / n as f32;
+        }
+    }
+    cdf[n] = 1.0;
+    // Guide entry k: the CDF entries in buckets below k (a histogram, then running sums).
+    let mut guide = vec![0u32; n + 1];
+    for &c in &cdf {
+        guide[bucket(c, n) + 1] += 1;
+    }
+    for k in 1..=n {
+        guide[k] += guide[k - 1];
+    }
+    let bins = (0..=n)
+        .map(|i| (cdf[i], func.get(i).copied().unwrap_or(0.0), guide[i]))
+        .collect();
+    (bins, integral)
+}
+
+/// The guide bucket of `u` among `n`: `floor(u n)`, clamped to `0..n`. Monotone in `u`,
+/// which is all the guide table relies on.
+#[inline(always)]
+fn bucket(u: f32, n: usize) -> usize {
+    ((u * n as f32) as usize).min(n - 1)
+}
+
+/// A 1D distribution's cells and integral, wherever they are stored: the searches and
+/// densities that [`Distribution1D`] and each row of a [`Distribution2D`] share.
+#[derive(Clone, Copy)]
+struct Row<'a, C> {
+    /// `n + 1` cells, as in [`Distribution1D`].
+    cells: &'a [C],
+    integral: f32,
+}
+
+impl<C: Bin> Row<'_, C> {
+    #[inline(always)]
+    fn len(&self) -> usize {
+        self.cells.len() - 1
+    }
+
+    /// The bin holding `x` in `[0, 1)` (clamped).
+    #[inline(always)]
+    fn bin(&self, x: f32) -> usize {
+        ((x * self.len() as f32) as usize).min(self.len() - 1)
+    }
+
+    /// The density of bin `i` with respect to `x`.
+    #[inline(always)]
+    fn pdf_of_bin(&self, i: usize) -> f32 {
+        if self.integral > 0.0 {
+            self.cells[i].func() / self.integral
+        } else {
+            1.0
+        }
+    }
+
+    fn discrete_pdf(&self, i: usize) -> f32 {
+        if i >= self.len() {
+            0.0
+        } else if self.integral > 0.0 {
+            self.cells[i].func() / (self.integral * self.len() as f32)
+        } else {
+            1.0 / self.len() as f32
+        }
+    }
+
+    #[inline]
+    fn sample_continuous(&self, u: f32) -> (f32, f32, usize) {
+        let i = self.find(u);
+        let (c0, c1) = (self.cells[i].cdf(), self.cells[i + 1].cdf());
+        let du = if c1 > c0 { (u - c0) / (c1 - c0) } else { 0.5 };
+        let x = ((i as f32 + du.clamp(0.0, 1.0)) / self.len() as f32).min(ONE_MINUS_EPSILON);
+        (x, self.pdf_of_bin(self.bin(x)), i)
+    }
+
+    fn sample_discrete(&self, u: f32) -> (usize, f32, f32) {
+        let i = self.find(u);
+        let (c0, c1) = (self.cells[i].cdf(), self.cells[i + 1].cdf());
+        let u_remapped = if c1 > c0 {
+            ((u - c0) / (c1 - c0)).clamp(0.0, ONE_MINUS_EPSILON)
+        } else {
+            0.5
+        };
+        (i, self.discrete_pdf(i), u_remapped)
+    }
+
+    /// The number of CDF entries `<= u`, i.e. `cdf.partition_point(|&c| c <= u)`, searched
+    /// only among the entries of `u`'s bucket `k`. Every entry in a lower bucket is below `u`
+    /// and every entry in a higher one above it (the bucket is monotone), so the count lies
+    /// between guide entries `k` and `k + 1`.
+    #[inline(always)]
+    fn count_at_or_below(&self, u: f32) -> usize {
+        let k = bucket(u, self.len());
+        let (lo, hi) = (
+            self.cells[k].guide() as usize,
+            self.cells[k + 1].guide() as usize,
+        );
+        lo + self.cells[lo..hi].partition_point(|c| c.cdf() <= u)
+    }
+
+    /// The last bin `i` with `cdf[i] <= u`, skipping empty bins.
+    #[inline(always)]
+    fn find(&self, u: f32) -> usize {
+        let n = self.len();
+        // The first index with cdf > u; the bin is one before it.
+        let first_above = self.count_at_or_below(u);
+        let mut i = first_above.saturating_sub(1).min(n - 1);
+        // Never land in a zero-weight bin through rounding at the CDF's flat parts.
+        while i + 1 < n && self.cells[i + 1].cdf() <= self.cells[i].cdf() {
+            i += 1;
+        }
+        i
+    }
 }
 
 impl Distribution1D {
@@ -50,50 +241,27 @@ impl<V: Copy + Default> Distribution1D<V> {
     }
 
     fn build(weights: &[f32], value: impl Fn(usize) -> V) -> Distribution1D<V> {
-        let mut func: Vec<f32> = weights
-            .iter()
-            .map(|&w| if w.is_finite() && w > 0.0 { w } else { 0.0 })
-            .collect();
-        if func.is_empty() {
-            func.push(1.0);
-        }
-        let n = func.len();
-        // Running sums in f64 so long rows do not lose their small bins.
-        let mut cdf = Vec::with_capacity(n + 1);
-        let mut sum = 0.0f64;
-        cdf.push(0.0f32);
-        for &f in &func {
-            sum += f64::from(f) / n as f64;
-            cdf.push(sum as f32);
-        }
-        let integral = sum as f32;
-        if integral > 0.0 {
-            for c in cdf.iter_mut().skip(1) {
-                *c /= integral;
-            }
-        } else {
-            for (i, c) in cdf.iter_mut().enumerate() {
-                *c = i as f32 / n as f32;
-            }
-        }
-        cdf[n] = 1.0;
-        // Guide entry k: the CDF entries in buckets below k (a histogram, then running sums).
-        let mut guide = vec![0u32; n + 1];
-        for &c in &cdf {
-            guide[Self::bucket(c, n) + 1] += 1;
-        }
-        for k in 1..=n {
-            guide[k] += guide[k - 1];
-        }
-        let cells = (0..=n)
-            .map(|i| Cell {
-                cdf: cdf[i],
-                func: func.get(i).copied().unwrap_or(0.0),
-                guide: guide[i],
+        let (bins, integral) = build_bins(weights);
+        let n = bins.len() - 1;
+        let cells = bins
+            .into_iter()
+            .enumerate()
+            .map(|(i, (cdf, func, guide))| Cell {
+                cdf,
+                func,
+                guide,
                 value: if i < n { value(i) } else { V::default() },
             })
             .collect();
         Distribution1D { cells, integral }
+    }
+
+    #[inline(always)]
+    fn row(&self) -> Row<'_, Cell<V>> {
+        Row {
+            cells: &self.cells,
+            integral: self.integral,
+        }
     }
 
     /// The number of bins.
@@ -111,11 +279,6 @@ impl<V: Copy + Default> Distribution1D<V> {
         self.integral
     }
 
-    /// The bin holding `x` in `[0, 1)` (clamped).
-    fn bin(&self, x: f32) -> usize {
-        ((x * self.len() as f32) as usize).min(self.len() - 1)
-    }
-
     /// The density at `x` in `[0, 1)` with respect to `x`.
     pub fn pdf(&self, x: f32) -> f32 {
         self.pdf_and_value(x).0
@@ -123,145 +286,158 @@ impl<V: Copy + Default> Distribution1D<V> {
 
     /// The value of the bin holding `x` in `[0, 1)` (clamped).
     pub fn value(&self, x: f32) -> V {
-        self.cells[self.bin(x)].value
+        self.cells[self.row().bin(x)].value
     }
 
     /// [`Distribution1D::pdf`] and [`Distribution1D::value`] at `x`, from one cell.
     pub fn pdf_and_value(&self, x: f32) -> (f32, V) {
-        let cell = &self.cells[self.bin(x)];
-        let pdf = if self.integral > 0.0 {
-            cell.func / self.integral
-        } else {
-            1.0
-        };
-        (pdf, cell.value)
+        let row = self.row();
+        let i = row.bin(x);
+        (row.pdf_of_bin(i), self.cells[i].value)
     }
 
     /// The probability of bin `i` (its share of the total weight).
     pub fn discrete_pdf(&self, i: usize) -> f32 {
-        if i >= self.len() {
-            0.0
-        } else if self.integral > 0.0 {
-            self.cells[i].func / (self.integral * self.len() as f32)
-        } else {
-            1.0 / self.len() as f32
-        }
+        self.row().discrete_pdf(i)
     }
 
     /// Inverts the CDF: returns `(x, pdf(x), bin)` for a canonical `u` in `[0, 1)`.
     pub fn sample_continuous(&self, u: f32) -> (f32, f32, usize) {
-        let i = self.find(u);
-        let (c0, c1) = (self.cells[i].cdf, self.cells[i + 1].cdf);
-        let du = if c1 > c0 { (u - c0) / (c1 - c0) } else { 0.5 };
-        let x = ((i as f32 + du.clamp(0.0, 1.0)) / self.len() as f32).min(ONE_MINUS_EPSILON);
-        (x, self.pdf(x), i)
+        self.row().sample_continuous(u)
     }
 
     /// Picks a bin with probability [`Distribution1D::discrete_pdf`]; returns it, its
     /// probability and `u` re-stretched to `[0, 1)` within the bin (reusable as a fresh number).
     pub fn sample_discrete(&self, u: f32) -> (usize, f32, f32) {
-        let i = self.find(u);
-        let (c0, c1) = (self.cells[i].cdf, self.cells[i + 1].cdf);
-        let u_remapped = if c1 > c0 {
-            ((u - c0) / (c1 - c0)).clamp(0.0, ONE_MINUS_EPSILON)
-        } else {
-            0.5
-        };
-        (i, self.discrete_pdf(i), u_remapped)
+        self.row().sample_discrete(u)
     }
 
-    /// The guide bucket of `u`: `floor(u n)`, clamped to `0..n`. Monotone in `u`, which is all
-    /// the guide table relies on.
-    fn bucket(u: f32, n: usize) -> usize {
-        ((u * n as f32) as usize).min(n - 1)
-    }
-
-    /// The number of CDF entries `<= u`, i.e. `cdf.partition_point(|&c| c <= u)`, searched
-    /// only among the entries of `u`'s bucket `k`. Every entry in a lower bucket is below `u`
-    /// and every entry in a higher one above it (the bucket is monotone), so the count lies
-    /// between guide entries `k` and `k + 1`.
+    #[cfg(test)]
     fn count_at_or_below(&self, u: f32) -> usize {
-        let k = Self::bucket(u, self.len());
-        let (lo, hi) = (
-            self.cells[k].guide as usize,
-            self.cells[k + 1].guide as usize,
-        );
-        lo + self.cells[lo..hi].partition_point(|c| c.cdf <= u)
-    }
-
-    /// The last bin `i` with `cdf[i] <= u`, skipping empty bins.
-    fn find(&self, u: f32) -> usize {
-        let n = self.len();
-        // The first index with cdf > u; the bin is one before it.
-        let first_above = self.count_at_or_below(u);
-        let mut i = first_above.saturating_sub(1).min(n - 1);
-        // Never land in a zero-weight bin through rounding at the CDF's flat parts.
-        while i + 1 < n && self.cells[i + 1].cdf <= self.cells[i].cdf {
-            i += 1;
-        }
-        i
+        self.row().count_at_or_below(u)
     }
 }
 
 /// A piecewise-constant density over `[0, 1)^2` on a `width x height` grid: a marginal
 /// distribution over rows (`v`) and a conditional one over columns (`u`) in each row. Each
-/// grid cell can carry a value `V`, as a [`Distribution1D`]'s bins do.
+/// grid cell carries an RGB value (an environment map's texel), stored beside the cell's
+/// weight so that a lookup reads one place in memory.
+///
+/// The rows' cells are one array of [`GridCell`]s, `height` rows of `width + 1`, held in `S`:
+/// a `Vec` by default, or whatever [`Distribution2D::with_values_stored`] is given (a large
+/// map's caller may keep it on huge pages, where a lookup does not also miss the TLB).
 #[derive(Debug, Clone, PartialEq)]
-pub struct Distribution2D<V = ()> {
-    conditional: Vec<Distribution1D<V>>,
+pub struct Distribution2D<S = Vec<GridCell>> {
+    cells: S,
+    /// Each row's integral (the conditional distribution's normaliser).
+    integrals: Vec<f32>,
+    width: usize,
     marginal: Distribution1D,
 }
 
 impl Distribution2D {
     /// From row-major weights (`weights[y * width + x]`); `weights.len()` must be `width * height`.
+    /// Every cell's value is zero.
     pub fn new(weights: &[f32], width: usize, height: usize) -> Distribution2D {
         Distribution2D::with_values(weights, &[], width, height)
     }
-}
 
-impl<V: Copy + Default> Distribution2D<V> {
-    /// [`Distribution2D::new`] with grid cell `(x, y)` carrying `values[y * width + x]` (the
-    /// default where `values` is shorter).
+    /// [`Distribution2D::new`] with grid cell `(x, y)` carrying `values[y * width + x]` (zero
+    /// where `values` is shorter).
     pub fn with_values(
         weights: &[f32],
-        values: &[V],
+        values: &[Vec3],
         width: usize,
         height: usize,
-    ) -> Distribution2D<V> {
+    ) -> Distribution2D {
+        Distribution2D::with_values_stored(weights, values, width, height, |cells| cells)
+    }
+}
+
+impl<S: Deref<Target = [GridCell]>> Distribution2D<S> {
+    /// [`Distribution2D::with_values`], its cells moved into the storage `store` makes of them
+    /// (it must keep them as they are, in order).
+    pub fn with_values_stored(
+        weights: &[f32],
+        values: &[Vec3],
+        width: usize,
+        height: usize,
+        store: impl FnOnce(Vec<GridCell>) -> S,
+    ) -> Distribution2D<S> {
         let width = width.max(1);
-        let conditional: Vec<Distribution1D<V>> = (0..height.max(1))
-            .map(|y| {
-                let row = weights.get(y * width..(y + 1) * width).unwrap_or(&[]);
-                let row_values = values.get(y * width..).unwrap_or(&[]);
-                let row_values = &row_values[..row_values.len().min(width)];
-                Distribution1D::with_values(row, row_values)
-            })
-            .collect();
-        let row_integrals: Vec<f32> = conditional.iter().map(|d| d.integral()).collect();
-        let marginal = Distribution1D::new(&row_integrals);
+        let height = height.max(1);
+        let mut cells = Vec::with_capacity(height * (width + 1));
+        let mut integrals = Vec::with_capacity(height);
+        for y in 0..height {
+            let row = weights.get(y * width..(y + 1) * width).unwrap_or(&[]);
+            let (bins, integral) = build_bins(row);
+            // A short row of weights still has `width` bins (the missing ones empty), so that
+            // every row has the same stride.
+            let (bins, integral) = if bins.len() == width + 1 {
+                (bins, integral)
+            } else {
+                let mut padded = row.to_vec();
+                padded.resize(width, 0.0);
+                build_bins(&padded)
+            };
+            cells.extend(bins.into_iter().enumerate().map(|(x, (cdf, func, guide))| {
+                let value = if x < width {
+                    values.get(y * width + x).copied().unwrap_or(Vec3::ZERO)
+                } else {
+                    Vec3::ZERO
+                };
+                GridCell {
+                    cdf,
+                    func,
+                    guide,
+                    value: value.to_array(),
+                }
+            }));
+            integrals.push(integral);
+        }
+        let marginal = Distribution1D::new(&integrals);
         Distribution2D {
-            conditional,
+            cells: store(cells),
+            integrals,
+            width,
             marginal,
         }
     }
 
-    /// Samples `(u, v)` in `[0, 1)^2` and returns it with its density.
-    pub fn sample(&self, u2: Vec2) -> (Vec2, f32) {
-        let (v, pdf_v, row) = self.marginal.sample_continuous(u2.y);
-        let (u, pdf_u, _) = self.conditional[row].sample_continuous(u2.x);
-        (Vec2::new(u, v), pdf_u * pdf_v)
-    }
-
-    /// [`Distribution2D::sample`] with the value of the grid cell holding the point.
-    pub fn sample_with_value(&self, u2: Vec2) -> (Vec2, f32, V) {
-        let (p, pdf) = self.sample(u2);
-        (p, pdf, self.value(p))
+    /// Row `y` of the grid (clamped to the last).
+    #[inline(always)]
+    fn row_at(&self, y: usize) -> Row<'_, GridCell> {
+        let y = y.min(self.integrals.len() - 1);
+        let stride = self.width + 1;
+        Row {
+            cells: &self.cells[y * stride..(y + 1) * stride],
+            integral: self.integrals[y],
+        }
     }
 
     /// The row holding `y` in `[0, 1)` (clamped).
-    fn row(&self, y: f32) -> &Distribution1D<V> {
-        let n = self.conditional.len();
-        &self.conditional[((y * n as f32) as usize).min(n - 1)]
+    #[inline(always)]
+    fn row(&self, y: f32) -> Row<'_, GridCell> {
+        let n = self.integrals.len();
+        self.row_at(((y * n as f32) as usize).min(n - 1))
+    }
+
+    /// Samples `(u, v)` in `[0, 1)^2` and returns it with its density.
+    pub fn sample(&self, u2: Vec2) -> (Vec2, f32) {
+        let (p, pdf, _) = self.sample_with_value(u2);
+        (p, pdf)
+    }
+
+    /// [`Distribution2D::sample`] with the value of the grid cell holding the point.
+    #[inline]
+    pub fn sample_with_value(&self, u2: Vec2) -> (Vec2, f32, Vec3) {
+        let (v, pdf_v, y) = self.marginal.sample_continuous(u2.y);
+        let (u, pdf_u, _) = self.row_at(y).sample_continuous(u2.x);
+        // The value of the cell holding the point, as `value` finds it: the row of `v`, which
+        // rounding can put one past row `y`.
+        let row = self.row(v);
+        let value = Vec3::from_array(row.cells[row.bin(u)].value);
+        (Vec2::new(u, v), pdf_u * pdf_v, value)
     }
 
     /// The density at `(u, v)` in `[0, 1)^2`.
@@ -270,14 +446,17 @@ impl<V: Copy + Default> Distribution2D<V> {
     }
 
     /// The value of the grid cell holding `p` in `[0, 1)^2` (clamped).
-    pub fn value(&self, p: Vec2) -> V {
-        self.row(p.y).value(p.x)
+    pub fn value(&self, p: Vec2) -> Vec3 {
+        self.pdf_and_value(p).1
     }
 
     /// [`Distribution2D::pdf`] and [`Distribution2D::value`] at `p`, from one cell of the grid.
-    pub fn pdf_and_value(&self, p: Vec2) -> (f32, V) {
-        let (pdf_u, value) = self.row(p.y).pdf_and_value(p.x);
-        (self.marginal.pdf(p.y) * pdf_u, value)
+    #[inline]
+    pub fn pdf_and_value(&self, p: Vec2) -> (f32, Vec3) {
+        let row = self.row(p.y);
+        let i = row.bin(p.x);
+        let value = Vec3::from_array(row.cells[i].value);
+        (self.marginal.pdf(p.y) * row.pdf_of_bin(i), value)
     }
 }
 
@@ -307,11 +486,15 @@ mod tests {
     fn values_sit_in_their_cells() {
         // A 3 x 2 grid: the point (0.5, 0.75) is in column 1 of row 1, cell 4; the last
         // cell's value is missing from the slice and is the default.
-        let d = Distribution2D::with_values(&[1.0; 6], &[10, 11, 12, 13, 14], 3, 2);
-        assert_eq!(d.value(Vec2::new(0.5, 0.75)), 14);
-        assert_eq!(d.value(Vec2::new(0.0, 0.0)), 10);
-        assert_eq!(d.value(Vec2::new(0.99, 0.99)), 0);
-        assert_eq!(d.pdf_and_value(Vec2::new(0.5, 0.25)), (1.0, 11));
+        let values = [10.0, 11.0, 12.0, 13.0, 14.0].map(Vec3::splat);
+        let d = Distribution2D::with_values(&[1.0; 6], &values, 3, 2);
+        assert_eq!(d.value(Vec2::new(0.5, 0.75)), Vec3::splat(14.0));
+        assert_eq!(d.value(Vec2::new(0.0, 0.0)), Vec3::splat(10.0));
+        assert_eq!(d.value(Vec2::new(0.99, 0.99)), Vec3::ZERO);
+        assert_eq!(
+            d.pdf_and_value(Vec2::new(0.5, 0.25)),
+            (1.0, Vec3::splat(11.0))
+        );
     }
 
     #[test]
@@ -372,13 +555,47 @@ mod tests {
         ) {
             // A 4 x 3 grid whose cells carry their own row-major index.
             let (w, h) = (4, 3);
-            let values: Vec<u32> = (0..12).collect();
+            let values: Vec<Vec3> = (0..12).map(|i| Vec3::new(i as f32, 0.0, -1.0)).collect();
             let d = Distribution2D::with_values(&weights, &values, w, h);
             let (p, pdf, value) = d.sample_with_value(Vec2::new(ux, uy));
             let (x, y) = ((p.x * w as f32) as u32, (p.y * h as f32) as u32);
-            prop_assert_eq!(value, y * w as u32 + x);
+            prop_assert_eq!(value, Vec3::new((y * w as u32 + x) as f32, 0.0, -1.0));
             prop_assert_eq!(d.pdf_and_value(p), (pdf, value));
             prop_assert_eq!(Distribution2D::new(&weights, w, h).sample(Vec2::new(ux, uy)), (p, pdf));
+        }
+
+        #[test]
+        fn each_row_samples_as_its_own_1d_distribution(
+            weights in proptest::collection::vec(
+                prop_oneof![Just(0.0f32), 0.0f32..10.0, 1e3f32..1e6], 1..60),
+            width in 1usize..9,
+            us in proptest::collection::vec(0.0f32..1.0, 8),
+        ) {
+            // The grid keeps its rows in one array; each must answer exactly as a
+            // Distribution1D over the row's weights, and so must the marginal over their
+            // integrals, whatever holds the cells.
+            let height = weights.len().div_ceil(width);
+            let mut padded = weights.clone();
+            padded.resize(width * height, 0.0);
+            let d = Distribution2D::new(&padded, width, height);
+            let boxed = Distribution2D::with_values_stored(
+                &padded, &[], width, height, Vec::into_boxed_slice);
+            let rows: Vec<Distribution1D> =
+                padded.chunks(width).map(Distribution1D::new).collect();
+            let marginal =
+                Distribution1D::new(&rows.iter().map(Distribution1D::integral).collect::<Vec<_>>());
+            for pair in us.chunks(2) {
+                let u2 = Vec2::new(pair[0], pair[1]);
+                let (v, pdf_v, y) = marginal.sample_continuous(u2.y);
+                let (u, pdf_u, _) = rows[y].sample_continuous(u2.x);
+                let expected = (Vec2::new(u, v), pdf_u * pdf_v);
+                prop_assert_eq!(d.sample(u2), expected);
+                prop_assert_eq!(boxed.sample(u2), expected);
+                let p = Vec2::new(u2.x, u2.y);
+                let row = ((p.y * height as f32) as usize).min(height - 1);
+                prop_assert_eq!(d.pdf(p), marginal.pdf(p.y) * rows[row].pdf(p.x));
+                prop_assert_eq!(boxed.pdf(p), d.pdf(p));
+            }
         }
 
         #[test]

@@ -5,7 +5,8 @@ use super::{LightSample, TINY, luminance};
 use crate::error::{ShadeError, check_non_negative};
 use core::f32::consts::{PI, TAU};
 use glam::{Mat3, Mat4, Vec2, Vec3};
-use obscura_sample::Distribution2D;
+use obscura_accel::Pages;
+use obscura_sample::{Distribution2D, GridCell};
 use obscura_sample::{square_to_uniform_sphere, uniform_sphere_pdf};
 
 /// Light from every direction at infinity: a constant radiance or an equirectangular map.
@@ -27,8 +28,9 @@ struct LatLongMap {
     /// The texels' sampling density, each cell carrying its texel's radiance: the grid of
     /// the distribution is the map's, so a texel and its density are one load apart. Lookups
     /// take the nearest texel, unfiltered: the radiance is piecewise constant exactly like
-    /// the sampling density.
-    distribution: Distribution2D<Vec3>,
+    /// the sampling density. On huge pages: every light sample and every escaped ray reads
+    /// the grid at random, and a map of a few megapixels spans thousands of ordinary pages.
+    distribution: Distribution2D<Pages<GridCell>>,
     world_from_light: Mat3,
     light_from_world: Mat3,
 }
@@ -90,7 +92,7 @@ impl EnvironmentLight {
                 weights.push(luminance(texels[y * w + x]) * sin_theta);
             }
         }
-        let distribution = Distribution2D::with_values(&weights, &texels, w, h);
+        let distribution = Distribution2D::with_values_stored(&weights, &texels, w, h, Pages::new);
         Ok(EnvironmentLight {
             kind: EnvironmentKind::Map(Box::new(LatLongMap {
                 distribution,
