@@ -169,14 +169,36 @@ impl Parallelogram {
     }
 }
 
-/// Maps a point with an absolute error bound through an affine matrix, growing the bound by
-/// the roundings of the matrix product (pbrt-v4's `Transform::operator()(Point3fi)`).
-pub(crate) fn transform_point_with_error(m: &Mat4, p: Vec3, p_error: Vec3) -> (Vec3, Vec3) {
+/// The absolute values of an affine matrix's linear part and translation: what the error
+/// bounds of points mapped through it are made of. Computed once per static placement.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct AbsAffine {
+    linear: glam::Mat3,
+    translation: Vec3,
+}
+
+impl AbsAffine {
+    /// The absolute values of `m`'s linear part and translation.
+    pub(crate) fn of(m: &Mat4) -> AbsAffine {
+        AbsAffine {
+            linear: glam::Mat3::from_mat4(*m).abs(),
+            translation: m.w_axis.truncate().abs(),
+        }
+    }
+}
+
+/// Maps a point with an absolute error bound through the affine matrix `m` (whose absolute
+/// values are `abs`), growing the bound by the roundings of the matrix product (pbrt-v4's
+/// `Transform::operator()(Point3fi)`).
+pub(crate) fn transform_point_with_error(
+    m: &Mat4,
+    abs: &AbsAffine,
+    p: Vec3,
+    p_error: Vec3,
+) -> (Vec3, Vec3) {
     let p_out = m.transform_point3(p);
-    let abs_linear = glam::Mat3::from_mat4(*m).abs();
-    let translation = m.w_axis.truncate().abs();
-    let rounding = gamma(3) * (abs_linear * p.abs() + translation);
-    let carried = (1.0 + gamma(3)) * (abs_linear * p_error);
+    let rounding = gamma(3) * (abs.linear * p.abs() + abs.translation);
+    let carried = (1.0 + gamma(3)) * (abs.linear * p_error);
     (p_out, rounding + carried)
 }
 
@@ -211,16 +233,15 @@ pub(crate) fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec
 /// The extra error of a hit found in object space: the ray's origin was carried there with
 /// `object_from_world` (rounded), so the surface point is uncertain by that rounding, mapped
 /// back to world space. Without it, spawned rays far from the origin re-hit moving surfaces.
+/// Takes the absolute values of both matrices ([`AbsAffine`]).
 pub(crate) fn object_space_error(
-    world_from_object: &Mat4,
-    object_from_world: &Mat4,
+    abs_world_from_object: &AbsAffine,
+    abs_object_from_world: &AbsAffine,
     p_world: Vec3,
 ) -> Vec3 {
-    let abs_inv = glam::Mat3::from_mat4(*object_from_world).abs();
-    let inv_translation = object_from_world.w_axis.truncate().abs();
-    let err_object = gamma(4) * (abs_inv * p_world.abs() + inv_translation);
-    let abs_linear = glam::Mat3::from_mat4(*world_from_object).abs();
-    (1.0 + gamma(3)) * (abs_linear * err_object)
+    let err_object = gamma(4)
+        * (abs_object_from_world.linear * p_world.abs() + abs_object_from_world.translation);
+    (1.0 + gamma(3)) * (abs_world_from_object.linear * err_object)
 }
 
 /// The next representable f32 above `v` (identity for +inf and NaN).

@@ -1,7 +1,7 @@
 //! Collecting shapes and building the scene: validation, flattening static meshes, one BVH per
 //! moving mesh, and the top level over everything.
 
-use super::{Analytic, Item, Scene, Top, Xform};
+use super::{Analytic, Item, Placed, Scene, Top, Xform};
 use crate::error::AccelError;
 use crate::geom::Parallelogram;
 use crate::mesh::TriangleMesh;
@@ -189,7 +189,7 @@ impl SceneBuilder {
             };
             let xform = match &placement {
                 Placement::Static(t) if t.is_identity() => Xform::Identity,
-                Placement::Static(t) => Xform::Static(*t),
+                Placement::Static(t) => Xform::Static(Placed::new(*t)),
                 Placement::Moving(a) => Xform::Moving(a.clone()),
             };
             statics.push(match &placement {

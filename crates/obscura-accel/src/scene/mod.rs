@@ -9,10 +9,10 @@ mod record;
 pub use builder::{BuildQuality, MAX_COORDINATE, SceneBuilder};
 pub use query::PreliminaryHit;
 
-use crate::geom::{Parallelogram, QuadHit};
+use crate::geom::{AbsAffine, Parallelogram, QuadHit};
 use crate::mesh::TriangleMesh;
 use crate::wide::{BoxSet, WideBvh, WideHit};
-use glam::{Vec3, Vec3A};
+use glam::{Mat4, Vec3, Vec3A};
 use obscura_space::{AnimatedTransform, Bounds3, Object, Ray, Transform, World};
 use obvhs::cwbvh::CwBvh;
 use std::sync::Arc;
@@ -59,32 +59,44 @@ enum Top {
 enum Xform {
     /// Object space is world space: rays need no transform.
     Identity,
-    Static(Transform<World, Object>),
+    Static(Placed),
     Moving(AnimatedTransform<World, Object>),
 }
 
-impl Xform {
-    #[inline]
-    fn at(&self, time: f32) -> Transform<World, Object> {
-        match self {
-            Xform::Identity => Transform::IDENTITY,
-            Xform::Static(t) => *t,
-            Xform::Moving(a) => a.at(time),
+/// A static placement with what every ray and hit through it reads, computed once: the
+/// absolute values of both matrices, which the hit's error bound is made of.
+#[derive(Debug, Clone)]
+struct Placed {
+    world_from_object: Transform<World, Object>,
+    abs: AbsAffine,
+    abs_inverse: AbsAffine,
+}
+
+impl Placed {
+    fn new(world_from_object: Transform<World, Object>) -> Placed {
+        Placed {
+            world_from_object,
+            abs: AbsAffine::of(&world_from_object.matrix()),
+            abs_inverse: AbsAffine::of(&world_from_object.inverse_matrix()),
         }
     }
+}
+
+impl Xform {
     /// The ray's origin and direction in object space at the ray's time.
     #[inline]
     fn ray_to_object(&self, r: &PlainRay) -> (Vec3A, Vec3A) {
         match self {
             Xform::Identity => (r.o, r.d),
-            _ => to_object(&self.at(r.time).inverse(), r),
+            Xform::Static(placed) => to_object(&placed.world_from_object.inverse_matrix(), r),
+            Xform::Moving(a) => to_object(&a.at(r.time).inverse_matrix(), r),
         }
     }
 
     fn bounds(&self, b: Bounds3<Object>) -> Bounds3<World> {
         match self {
             Xform::Identity => Transform::IDENTITY.bounds(b),
-            Xform::Static(t) => t.bounds(b),
+            Xform::Static(placed) => placed.world_from_object.bounds(b),
             Xform::Moving(a) => a.motion_bounds(b),
         }
     }
@@ -186,10 +198,10 @@ impl From<&PlainRay> for crate::wide::BatchRay {
     }
 }
 
-/// The ray's origin and direction carried into object space.
+/// The ray's origin and direction carried into object space by the matrix
+/// `object_from_world`.
 #[inline]
-fn to_object(object_from_world: &Transform<Object, World>, r: &PlainRay) -> (Vec3A, Vec3A) {
-    let m = object_from_world.matrix();
+fn to_object(m: &Mat4, r: &PlainRay) -> (Vec3A, Vec3A) {
     (
         Vec3A::from(m.transform_point3(Vec3::from(r.o))),
         Vec3A::from(m.transform_vector3(Vec3::from(r.d))),

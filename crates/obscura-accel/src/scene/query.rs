@@ -468,8 +468,7 @@ impl Scene {
                 world_from_object,
                 ..
             } => {
-                let object_from_world = world_from_object.at(r.time).inverse();
-                let (o, d) = to_object(&object_from_world, r);
+                let (o, d) = to_object(&world_from_object.at(r.time).inverse_matrix(), r);
                 let hit = self.blases[*blas].closest(o, d, r.t_min, t_max)?;
                 Some(Found::Moving { item, hit })
             }
@@ -503,8 +502,7 @@ impl Scene {
                 world_from_object,
                 ..
             } => {
-                let object_from_world = world_from_object.at(r.time).inverse();
-                let (o, d) = to_object(&object_from_world, r);
+                let (o, d) = to_object(&world_from_object.at(r.time).inverse_matrix(), r);
                 self.blases[*blas].any(o, d, r.t_min, r.t_max)
             }
             Item::Analytic { .. } => self.intersect_item(item, r, r.t_max).is_some(),

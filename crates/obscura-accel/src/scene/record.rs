@@ -3,7 +3,7 @@
 
 use super::{Analytic, Found, Item, PlainRay, Scene, Xform};
 use crate::geom::{
-    Parallelogram, TriangleHit, gamma, object_space_error, transform_point_with_error,
+    AbsAffine, Parallelogram, TriangleHit, gamma, object_space_error, transform_point_with_error,
 };
 use crate::hit::Hit;
 use crate::mesh::TriangleMesh;
@@ -56,7 +56,7 @@ impl Scene {
                     .expect("moving mesh instances are meshes");
                 let world_from_object = world_from_object.at(r.time);
                 let (p_object, err_object) = edge_point(&hit);
-                let (p, p_error) = point_to_world(&world_from_object, p_object, err_object);
+                let (p, p_error) = point_to_world_at(&world_from_object, p_object, err_object);
                 let n_geo = normal_to_world(&world_from_object, hit.e1.cross(hit.e2));
                 self.triangle_hit(
                     r,
@@ -156,9 +156,20 @@ impl Scene {
         let (p, p_error, n) = match xform {
             // Object space is world space: nothing to carry, no rounding to add.
             Xform::Identity => (p_object, err_object, n_object.normalize()),
-            _ => {
-                let world_from_object = xform.at(r.time);
-                let (p, p_error) = point_to_world(&world_from_object, p_object, err_object);
+            Xform::Static(placed) => {
+                let world_from_object = &placed.world_from_object;
+                let (p, p_error) = point_to_world(
+                    world_from_object,
+                    &placed.abs,
+                    &placed.abs_inverse,
+                    p_object,
+                    err_object,
+                );
+                (p, p_error, normal_to_world(world_from_object, n_object))
+            }
+            Xform::Moving(a) => {
+                let world_from_object = a.at(r.time);
+                let (p, p_error) = point_to_world_at(&world_from_object, p_object, err_object);
                 (p, p_error, normal_to_world(&world_from_object, n_object))
             }
         };
@@ -224,17 +235,33 @@ impl Scene {
 
 /// A hit point found in object space, carried to world space with its error bound: the
 /// rounding of the transform itself plus that of having carried the ray into object space.
+/// `abs` and `abs_inverse` are the absolute values of the transform's two matrices.
 #[inline]
 fn point_to_world(
+    world_from_object: &Transform<World, Object>,
+    abs: &AbsAffine,
+    abs_inverse: &AbsAffine,
+    p_object: Vec3,
+    err_object: Vec3,
+) -> (Vec3, Vec3) {
+    let (p, p_error) =
+        transform_point_with_error(&world_from_object.matrix(), abs, p_object, err_object);
+    (p, p_error + object_space_error(abs, abs_inverse, p))
+}
+
+/// [`point_to_world`] through a transform met once (a moving instance at the ray's time).
+#[inline]
+fn point_to_world_at(
     world_from_object: &Transform<World, Object>,
     p_object: Vec3,
     err_object: Vec3,
 ) -> (Vec3, Vec3) {
-    let m = world_from_object.matrix();
-    let (p, p_error) = transform_point_with_error(&m, p_object, err_object);
-    (
-        p,
-        p_error + object_space_error(&m, &world_from_object.inverse_matrix(), p),
+    point_to_world(
+        world_from_object,
+        &AbsAffine::of(&world_from_object.matrix()),
+        &AbsAffine::of(&world_from_object.inverse_matrix()),
+        p_object,
+        err_object,
     )
 }
 
