@@ -23,13 +23,21 @@ pub struct Distribution1D<V = ()> {
     integral: f32,
 }
 
-/// One bin of a [`Distribution1D`].
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Cell<V> {
+/// What a search reads of a bin: the CDF where it starts, its weight (0 in the last cell)
+/// and its guide entry.
+#[derive(Debug, Clone, Copy, PartialEq, Default, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C)]
+struct Bin {
     cdf: f32,
     func: f32,
     /// How many CDF entries fall in guide buckets below this cell's index (see [`bucket`]).
     guide: u32,
+}
+
+/// One bin of a [`Distribution1D`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Cell<V> {
+    bin: Bin,
     value: V,
 }
 
@@ -41,52 +49,32 @@ struct Cell<V> {
 #[derive(Debug, Clone, Copy, PartialEq, Default, bytemuck::Pod, bytemuck::Zeroable)]
 #[repr(C)]
 pub struct GridCell {
-    cdf: f32,
-    func: f32,
-    guide: u32,
+    bin: Bin,
     value: [f32; 3],
 }
 
-/// What the searches read of a cell, whichever kind it is.
-trait Bin: Copy {
-    fn cdf(&self) -> f32;
-    fn func(&self) -> f32;
-    fn guide(&self) -> u32;
+/// A cell of either kind, as the searches see it.
+trait HasBin: Copy {
+    fn bin(&self) -> &Bin;
 }
 
-impl<V: Copy> Bin for Cell<V> {
+impl<V: Copy> HasBin for Cell<V> {
     #[inline(always)]
-    fn cdf(&self) -> f32 {
-        self.cdf
-    }
-    #[inline(always)]
-    fn func(&self) -> f32 {
-        self.func
-    }
-    #[inline(always)]
-    fn guide(&self) -> u32 {
-        self.guide
+    fn bin(&self) -> &Bin {
+        &self.bin
     }
 }
 
-impl Bin for GridCell {
+impl HasBin for GridCell {
     #[inline(always)]
-    fn cdf(&self) -> f32 {
-        self.cdf
-    }
-    #[inline(always)]
-    fn func(&self) -> f32 {
-        self.func
-    }
-    #[inline(always)]
-    fn guide(&self) -> u32 {
-        self.guide
+    fn bin(&self) -> &Bin {
+        &self.bin
     }
 }
 
 /// A 1D distribution's `n + 1` cells as built: CDF entry, weight and guide entry of each,
 /// and the weights' integral (see [`Distribution1D`]).
-fn build_bins(weights: &[f32]) -> (Vec<(f32, f32, u32)>, f32) {
+fn build_bins(weights: &[f32]) -> (Vec<Bin>, f32) {
     let mut func: Vec<f32> = weights
         .iter()
         .map(|&w| if w.is_finite() && w > 0.0 { w } else { 0.0 })
@@ -123,7 +111,11 @@ fn build_bins(weights: &[f32]) -> (Vec<(f32, f32, u32)>, f32) {
         guide[k] += guide[k - 1];
     }
     let bins = (0..=n)
-        .map(|i| (cdf[i], func.get(i).copied().unwrap_or(0.0), guide[i]))
+        .map(|i| Bin {
+            cdf: cdf[i],
+            func: func.get(i).copied().unwrap_or(0.0),
+            guide: guide[i],
+        })
         .collect();
     (bins, integral)
 }
@@ -144,7 +136,7 @@ struct Row<'a, C> {
     integral: f32,
 }
 
-impl<C: Bin> Row<'_, C> {
+impl<C: HasBin> Row<'_, C> {
     #[inline(always)]
     fn len(&self) -> usize {
         self.cells.len() - 1
@@ -160,7 +152,7 @@ impl<C: Bin> Row<'_, C> {
     #[inline(always)]
     fn pdf_of_bin(&self, i: usize) -> f32 {
         if self.integral > 0.0 {
-            self.cells[i].func() / self.integral
+            self.cells[i].bin().func / self.integral
         } else {
             1.0
         }
@@ -170,7 +162,7 @@ impl<C: Bin> Row<'_, C> {
         if i >= self.len() {
             0.0
         } else if self.integral > 0.0 {
-            self.cells[i].func() / (self.integral * self.len() as f32)
+            self.cells[i].bin().func / (self.integral * self.len() as f32)
         } else {
             1.0 / self.len() as f32
         }
@@ -179,7 +171,7 @@ impl<C: Bin> Row<'_, C> {
     #[inline]
     fn sample_continuous(&self, u: f32) -> (f32, f32, usize) {
         let i = self.find(u);
-        let (c0, c1) = (self.cells[i].cdf(), self.cells[i + 1].cdf());
+        let (c0, c1) = (self.cells[i].bin().cdf, self.cells[i + 1].bin().cdf);
         let du = if c1 > c0 { (u - c0) / (c1 - c0) } else { 0.5 };
         let x = ((i as f32 + du.clamp(0.0, 1.0)) / self.len() as f32).min(ONE_MINUS_EPSILON);
         (x, self.pdf_of_bin(self.bin(x)), i)
@@ -187,7 +179,7 @@ impl<C: Bin> Row<'_, C> {
 
     fn sample_discrete(&self, u: f32) -> (usize, f32, f32) {
         let i = self.find(u);
-        let (c0, c1) = (self.cells[i].cdf(), self.cells[i + 1].cdf());
+        let (c0, c1) = (self.cells[i].bin().cdf, self.cells[i + 1].bin().cdf);
         let u_remapped = if c1 > c0 {
             ((u - c0) / (c1 - c0)).clamp(0.0, ONE_MINUS_EPSILON)
         } else {
@@ -204,10 +196,10 @@ impl<C: Bin> Row<'_, C> {
     fn count_at_or_below(&self, u: f32) -> usize {
         let k = bucket(u, self.len());
         let (lo, hi) = (
-            self.cells[k].guide() as usize,
-            self.cells[k + 1].guide() as usize,
+            self.cells[k].bin().guide as usize,
+            self.cells[k + 1].bin().guide as usize,
         );
-        lo + self.cells[lo..hi].partition_point(|c| c.cdf() <= u)
+        lo + self.cells[lo..hi].partition_point(|c| c.bin().cdf <= u)
     }
 
     /// The last bin `i` with `cdf[i] <= u`, skipping empty bins.
@@ -218,7 +210,7 @@ impl<C: Bin> Row<'_, C> {
         let first_above = self.count_at_or_below(u);
         let mut i = first_above.saturating_sub(1).min(n - 1);
         // Never land in a zero-weight bin through rounding at the CDF's flat parts.
-        while i + 1 < n && self.cells[i + 1].cdf() <= self.cells[i].cdf() {
+        while i + 1 < n && self.cells[i + 1].bin().cdf <= self.cells[i].bin().cdf {
             i += 1;
         }
         i
@@ -246,10 +238,8 @@ impl<V: Copy + Default> Distribution1D<V> {
         let cells = bins
             .into_iter()
             .enumerate()
-            .map(|(i, (cdf, func, guide))| Cell {
-                cdf,
-                func,
-                guide,
+            .map(|(i, bin)| Cell {
+                bin,
                 value: if i < n { value(i) } else { V::default() },
             })
             .collect();
@@ -380,16 +370,14 @@ impl<S: Deref<Target = [GridCell]>> Distribution2D<S> {
                 padded.resize(width, 0.0);
                 build_bins(&padded)
             };
-            cells.extend(bins.into_iter().enumerate().map(|(x, (cdf, func, guide))| {
+            cells.extend(bins.into_iter().enumerate().map(|(x, bin)| {
                 let value = if x < width {
                     values.get(y * width + x).copied().unwrap_or(Vec3::ZERO)
                 } else {
                     Vec3::ZERO
                 };
                 GridCell {
-                    cdf,
-                    func,
-                    guide,
+                    bin,
                     value: value.to_array(),
                 }
             }));
@@ -517,7 +505,7 @@ mod tests {
             picks in proptest::collection::vec(0usize..1000, 16),
         ) {
             let d = Distribution1D::new(&weights);
-            let cdf: Vec<f32> = d.cells.iter().map(|c| c.cdf).collect();
+            let cdf: Vec<f32> = d.cells.iter().map(|c| c.bin.cdf).collect();
             // Random u, and u exactly on CDF entries and one ulp either side of them, where a
             // bucket boundary and a CDF step can meet.
             let mut probes = us.clone();
