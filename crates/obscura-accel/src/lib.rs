@@ -21,6 +21,9 @@
 //! - Hits: [`Hit`] carries the world-space point with a conservative error bound, and
 //!   [`Hit::spawn_ray`] / [`Hit::spawn_ray_to`] offset new rays by that bound (pbrt's method), so
 //!   a surface does not shadow itself.
+//! - Memory: [`Pages`] keeps a large read-only array on transparent huge pages where the system
+//!   gives them (the BVH and the meshes live in them; obscura-shade puts environment maps there
+//!   too), so that a ray's random reads do not also miss the TLB.
 //!
 //! The decision to know: visibility is decided at the ray's own time. Static meshes are
 //! flattened into world space once and share one BVH; a moving instance is bounded in the top
