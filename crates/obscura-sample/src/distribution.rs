@@ -358,18 +358,11 @@ impl<S: Deref<Target = [GridCell]>> Distribution2D<S> {
         let height = height.max(1);
         let mut cells = Vec::with_capacity(height * (width + 1));
         let mut integrals = Vec::with_capacity(height);
+        // A row missing from `weights` has `width` empty bins, so every row has one stride.
+        let empty = vec![0.0; width];
         for y in 0..height {
-            let row = weights.get(y * width..(y + 1) * width).unwrap_or(&[]);
+            let row = weights.get(y * width..(y + 1) * width).unwrap_or(&empty);
             let (bins, integral) = build_bins(row);
-            // A short row of weights still has `width` bins (the missing ones empty), so that
-            // every row has the same stride.
-            let (bins, integral) = if bins.len() == width + 1 {
-                (bins, integral)
-            } else {
-                let mut padded = row.to_vec();
-                padded.resize(width, 0.0);
-                build_bins(&padded)
-            };
             cells.extend(bins.into_iter().enumerate().map(|(x, bin)| {
                 let value = if x < width {
                     values.get(y * width + x).copied().unwrap_or(Vec3::ZERO)
@@ -411,21 +404,18 @@ impl<S: Deref<Target = [GridCell]>> Distribution2D<S> {
     }
 
     /// Samples `(u, v)` in `[0, 1)^2` and returns it with its density.
+    #[inline]
     pub fn sample(&self, u2: Vec2) -> (Vec2, f32) {
-        let (p, pdf, _) = self.sample_with_value(u2);
-        (p, pdf)
+        let (v, pdf_v, y) = self.marginal.sample_continuous(u2.y);
+        let (u, pdf_u, _) = self.row_at(y).sample_continuous(u2.x);
+        (Vec2::new(u, v), pdf_u * pdf_v)
     }
 
     /// [`Distribution2D::sample`] with the value of the grid cell holding the point.
     #[inline]
     pub fn sample_with_value(&self, u2: Vec2) -> (Vec2, f32, Vec3) {
-        let (v, pdf_v, y) = self.marginal.sample_continuous(u2.y);
-        let (u, pdf_u, _) = self.row_at(y).sample_continuous(u2.x);
-        // The value of the cell holding the point, as `value` finds it: the row of `v`, which
-        // rounding can put one past row `y`.
-        let row = self.row(v);
-        let value = Vec3::from_array(row.cells[row.bin(u)].value);
-        (Vec2::new(u, v), pdf_u * pdf_v, value)
+        let (p, pdf) = self.sample(u2);
+        (p, pdf, self.value(p))
     }
 
     /// The density at `(u, v)` in `[0, 1)^2`.
@@ -434,8 +424,10 @@ impl<S: Deref<Target = [GridCell]>> Distribution2D<S> {
     }
 
     /// The value of the grid cell holding `p` in `[0, 1)^2` (clamped).
+    #[inline]
     pub fn value(&self, p: Vec2) -> Vec3 {
-        self.pdf_and_value(p).1
+        let row = self.row(p.y);
+        Vec3::from_array(row.cells[row.bin(p.x)].value)
     }
 
     /// [`Distribution2D::pdf`] and [`Distribution2D::value`] at `p`, from one cell of the grid.
