@@ -1,9 +1,9 @@
 //! The full hit record built from what a query found: world point with its error bound,
 //! normals, surface coordinates.
 
-use super::{Analytic, Found, Item, PlainRay, Scene, Xform};
+use super::{Analytic, Found, Item, Placed, PlainRay, Scene, Xform};
 use crate::geom::{
-    AbsAffine, Parallelogram, TriangleHit, gamma, object_space_error, transform_point_with_error,
+    Parallelogram, TriangleHit, gamma, object_space_error, transform_point_with_error,
 };
 use crate::hit::Hit;
 use crate::mesh::TriangleMesh;
@@ -54,10 +54,10 @@ impl Scene {
                 let mesh = self.meshes[*instance as usize]
                     .as_ref()
                     .expect("moving mesh instances are meshes");
-                let world_from_object = world_from_object.at(r.time);
+                let placed = Placed::new(world_from_object.at(r.time));
                 let (p_object, err_object) = edge_point(&hit);
-                let (p, p_error) = point_to_world_at(&world_from_object, p_object, err_object);
-                let n_geo = normal_to_world(&world_from_object, hit.e1.cross(hit.e2));
+                let (p, p_error, n_geo) =
+                    placed.hit_to_world(p_object, err_object, hit.e1.cross(hit.e2));
                 self.triangle_hit(
                     r,
                     hit.tri,
@@ -67,7 +67,7 @@ impl Scene {
                     mesh,
                     hit.ids[0],
                     *instance,
-                    &world_from_object,
+                    &placed.world_from_object,
                 )
             }
             Found::Sphere { item, t } => {
@@ -156,21 +156,9 @@ impl Scene {
         let (p, p_error, n) = match xform {
             // Object space is world space: nothing to carry, no rounding to add.
             Xform::Identity => (p_object, err_object, n_object.normalize()),
-            Xform::Static(placed) => {
-                let world_from_object = &placed.world_from_object;
-                let (p, p_error) = point_to_world(
-                    world_from_object,
-                    &placed.abs,
-                    &placed.abs_inverse,
-                    p_object,
-                    err_object,
-                );
-                (p, p_error, normal_to_world(world_from_object, n_object))
-            }
+            Xform::Static(placed) => placed.hit_to_world(p_object, err_object, n_object),
             Xform::Moving(a) => {
-                let world_from_object = a.at(r.time);
-                let (p, p_error) = point_to_world_at(&world_from_object, p_object, err_object);
-                (p, p_error, normal_to_world(&world_from_object, n_object))
+                Placed::new(a.at(r.time)).hit_to_world(p_object, err_object, n_object)
             }
         };
         let n = Normal3::from_glam(n);
@@ -233,36 +221,29 @@ impl Scene {
     }
 }
 
-/// A hit point found in object space, carried to world space with its error bound: the
-/// rounding of the transform itself plus that of having carried the ray into object space.
-/// `abs` and `abs_inverse` are the absolute values of the transform's two matrices.
-#[inline]
-fn point_to_world(
-    world_from_object: &Transform<World, Object>,
-    abs: &AbsAffine,
-    abs_inverse: &AbsAffine,
-    p_object: Vec3,
-    err_object: Vec3,
-) -> (Vec3, Vec3) {
-    let (p, p_error) =
-        transform_point_with_error(&world_from_object.matrix(), abs, p_object, err_object);
-    (p, p_error + object_space_error(abs, abs_inverse, p))
-}
+impl Placed {
+    /// A hit point found in object space, carried to world space with its error bound: the
+    /// rounding of the transform itself plus that of having carried the ray into object space.
+    #[inline]
+    fn point_to_world(&self, p_object: Vec3, err_object: Vec3) -> (Vec3, Vec3) {
+        let m = self.world_from_object.matrix();
+        let (p, p_error) = transform_point_with_error(&m, &self.abs, p_object, err_object);
+        (
+            p,
+            p_error + object_space_error(&self.abs, &self.abs_inverse, p),
+        )
+    }
 
-/// [`point_to_world`] through a transform met once (a moving instance at the ray's time).
-#[inline]
-fn point_to_world_at(
-    world_from_object: &Transform<World, Object>,
-    p_object: Vec3,
-    err_object: Vec3,
-) -> (Vec3, Vec3) {
-    point_to_world(
-        world_from_object,
-        &AbsAffine::of(&world_from_object.matrix()),
-        &AbsAffine::of(&world_from_object.inverse_matrix()),
-        p_object,
-        err_object,
-    )
+    /// [`Placed::point_to_world`] and the unit world normal of `n_object`.
+    #[inline]
+    fn hit_to_world(&self, p_object: Vec3, err_object: Vec3, n_object: Vec3) -> (Vec3, Vec3, Vec3) {
+        let (p, p_error) = self.point_to_world(p_object, err_object);
+        (
+            p,
+            p_error,
+            normal_to_world(&self.world_from_object, n_object),
+        )
+    }
 }
 
 /// A unit world normal from an object-space normal, by the inverse transpose.
