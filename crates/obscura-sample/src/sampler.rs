@@ -136,8 +136,8 @@ impl Sampler {
     ///
     /// Pure function of (pixel, index, dimension, seed). Indices at or beyond
     /// [`Sampler::samples_per_pixel`] are valid: the stratified sampler starts a fresh,
-    /// independently shuffled pattern every `samples_per_pixel` indices, and the sequences
-    /// simply continue.
+    /// independently shuffled pattern every `samples_per_pixel` indices, Sobol shuffles each
+    /// such block of its sequence afresh, and Halton simply continues.
     #[inline]
     pub fn value(&self, pixel: [u32; 2], index: u32, dimension: u32) -> f32 {
         self.value_keyed(self.key(pixel), index, dimension)
@@ -168,7 +168,9 @@ impl Sampler {
                 dimension,
             ),
             SamplerKind::Halton => sequences::halton(pixel_key, index, dimension),
-            SamplerKind::Sobol => sequences::sobol(pixel_key, index, dimension),
+            SamplerKind::Sobol => {
+                sequences::sobol(pixel_key, self.samples_per_pixel, index, dimension)
+            }
         }
     }
 
@@ -179,7 +181,7 @@ impl Sampler {
             sampler: self,
             pixel_key: self.key(pixel),
             index,
-            index_reversed: index.reverse_bits(),
+            sobol_index: sequences::SobolIndex::new(index, self.samples_per_pixel),
             dimension: 0,
             sobol_last: None,
         }
@@ -198,8 +200,8 @@ pub struct SampleStream<'a> {
     sampler: &'a Sampler,
     pixel_key: u64,
     index: u32,
-    /// `index.reverse_bits()`: Sobol's index shuffle starts from it for every pair.
-    index_reversed: u32,
+    /// Where `index` sits in its block of samples, for Sobol's index shuffle of every pair.
+    sobol_index: sequences::SobolIndex,
     dimension: u32,
     /// Sobol only: the shared part of the pair last read one dimension at a time, so reading
     /// its other dimension next costs one scramble (the values are the same either way).
@@ -264,8 +266,7 @@ impl SampleStream<'_> {
         let prepared = match self.sobol_last {
             Some(last) if last.pair == pair => last,
             _ => {
-                let prepared =
-                    sequences::sobol_prepare_reversed(self.pixel_key, self.index_reversed, pair);
+                let prepared = sequences::sobol_prepare(self.pixel_key, self.sobol_index, pair);
                 self.sobol_last = Some(prepared);
                 prepared
             }
@@ -279,9 +280,9 @@ impl SampleStream<'_> {
     fn pair(&self, first: u32) -> Vec2 {
         let (sampler, key, index) = (self.sampler, self.pixel_key, self.index);
         match sampler.kind {
-            SamplerKind::Sobol if first.is_multiple_of(2) => Vec2::from(
-                sequences::sobol_pair_reversed(key, self.index_reversed, first / 2),
-            ),
+            SamplerKind::Sobol if first.is_multiple_of(2) => {
+                Vec2::from(sequences::sobol_pair(key, self.sobol_index, first / 2))
+            }
             _ => Vec2::new(
                 sampler.value_keyed(key, index, first),
                 sampler.value_keyed(key, index, first.saturating_add(1)),

@@ -7,7 +7,8 @@ use rand_core::Rng;
 use rand_pcg::Pcg32;
 
 use crate::hash::{
-    combine, in_stratum, mix64, owen_hash, permute, unit_f32_from_bits, unit_f64_from_bits,
+    Permutation, combine, in_stratum, mix64, owen_hash, permute, unit_f32_from_bits,
+    unit_f64_from_bits,
 };
 
 /// Tags that keep the hash streams of the samplers and of their parts apart.
@@ -164,45 +165,38 @@ pub(crate) fn halton(pixel_key: u64, index: u32, dimension: u32) -> f32 {
 
 /// The second dimension of the Sobol sequence as a 32-bit binary fraction: its generator
 /// matrix is Pascal's triangle modulo 2, whose successive columns `v` are obtained by
-/// `v ^= v >> 1` from `v = 1 << 31`. Read from [`raw_pair_reversed`]'s tables, as the
-/// sampler reads it.
+/// `v ^= v >> 1` from `v = 1 << 31`. Read from [`raw_pair`]'s tables, as the sampler reads it.
 #[cfg(test)]
 pub(crate) fn sobol_second(index: u32) -> u32 {
-    raw_pair_reversed(index.reverse_bits())[1].reverse_bits()
+    raw_pair(index)[1].reverse_bits()
 }
 
-/// Both raw coordinates of a pair's (0,2)-sequence point, bit-reversed as the Owen scramble
-/// consumes them, from the shuffled sample index *with its bits reversed* (as the index
-/// shuffle gives it): the van der Corput value `shuffled.reverse_bits()` and
-/// `sobol_second_bitwise(shuffled)`, each reversed, for `shuffled =
-/// shuffled_reversed.reverse_bits()`.
+/// Both raw coordinates of a pair's (0,2)-sequence point at (shuffled) index `shuffled`,
+/// bit-reversed as the Owen scramble consumes them: the van der Corput value reversed, which
+/// is `shuffled` itself, and [`sobol_second_bitwise`]`(shuffled)` reversed.
 ///
-/// Both are linear over XOR in the index bits (bit reversal distributes over XOR), so they are
-/// read from four tables of 256 entries, one per byte, each entry holding the two coordinates
-/// of that byte (first in the low half). The index is Owen-shuffled before it gets here, so it
-/// has all 32 bits set at random: the bit-by-bit product (the reference) mispredicted a branch
-/// per bit, and the tables also spare the shuffle's bit reversal.
+/// The second is linear over XOR in the index bits (bit reversal distributes over XOR), so it
+/// is read from four tables of 256 entries, one per byte of the index: the bit-by-bit product
+/// (the reference) mispredicted a branch per set bit.
 #[inline]
-pub(crate) fn raw_pair_reversed(shuffled_reversed: u32) -> [u32; 2] {
-    let [b0, b1, b2, b3] = shuffled_reversed.to_le_bytes();
-    let both = RAW_PAIR_REVERSED[0][b0 as usize]
-        ^ RAW_PAIR_REVERSED[1][b1 as usize]
-        ^ RAW_PAIR_REVERSED[2][b2 as usize]
-        ^ RAW_PAIR_REVERSED[3][b3 as usize];
-    [both as u32, (both >> 32) as u32]
+pub(crate) fn raw_pair(shuffled: u32) -> [u32; 2] {
+    let [b0, b1, b2, b3] = shuffled.to_le_bytes();
+    let second = SECOND_REVERSED[0][b0 as usize]
+        ^ SECOND_REVERSED[1][b1 as usize]
+        ^ SECOND_REVERSED[2][b2 as usize]
+        ^ SECOND_REVERSED[3][b3 as usize];
+    [shuffled, second]
 }
 
-/// `RAW_PAIR_REVERSED[k][b]`: [`raw_pair_reversed`] of byte `b` placed at bits `8k..8k + 8`,
-/// computed at compile time from the bitwise reference.
-static RAW_PAIR_REVERSED: [[u64; 256]; 4] = {
-    let mut table = [[0u64; 256]; 4];
+/// `SECOND_REVERSED[k][b]`: the second Sobol dimension, bit-reversed, of byte `b` placed at
+/// bits `8k..8k + 8` of the index, computed at compile time from the bitwise reference.
+static SECOND_REVERSED: [[u32; 256]; 4] = {
+    let mut table = [[0u32; 256]; 4];
     let mut k = 0;
     while k < 4 {
         let mut b = 0;
         while b < 256 {
-            let shuffled = ((b as u32) << (8 * k)).reverse_bits();
-            let second = sobol_second_bitwise(shuffled).reverse_bits();
-            table[k][b] = shuffled as u64 | (second as u64) << 32;
+            table[k][b] = sobol_second_bitwise((b as u32) << (8 * k)).reverse_bits();
             b += 1;
         }
         k += 1;
@@ -229,37 +223,85 @@ pub(crate) const fn sobol_second_bitwise(mut index: u32) -> u32 {
 /// (0,2)-sequence (van der Corput, second Sobol dimension), its sample index shuffled per
 /// (pixel, pair) and each coordinate Owen-scrambled per (pixel, pair, coordinate).
 ///
-/// The index shuffle is itself a nested uniform scramble of the index bits, which maps the
-/// indices `0..2^m` onto an aligned block of `2^m` indices: those are again a (0,m,2)-net, and
-/// Owen scrambling keeps nets, so every pair of dimensions of the first `2^m` samples puts
-/// exactly one point in each elementary interval of area `2^-m`.
+/// The index shuffle is a pseudo-random permutation ([`permute`]) of each block of `spp`
+/// consecutive indices (a pass over the pixel's samples) onto itself, drawn per (pixel, pair,
+/// block), as pbrt-v4's padded Sobol sampler and Mitsuba 3's `ldsampler` do; the film pair
+/// (`p = 0`) is not shuffled, which leaves every pair's pairing with every other a random
+/// permutation. Each block holds the same points as before its shuffle, so when `spp = 2^m`
+/// every pair of every block is a (0,m,2)-net (one point in each elementary interval of area
+/// `2^-m`; Owen scrambling keeps nets), and the film's first `2^k` samples are nets too.
+///
+/// Not a nested scramble of the index bits, although that would keep every pair's first `2^k`
+/// samples nets as well: it pairs the strata of different pairs with a structure of its own,
+/// which renders measured noisier (docs/performance.md, "The Sobol sampler's index shuffle").
 ///
 /// `key` is the pixel's key tagged for Sobol by [`sobol_key`] (once per pixel, not per value).
 #[inline]
-pub(crate) fn sobol(key: u64, index: u32, dimension: u32) -> f32 {
-    let prepared = sobol_prepare(key, index, dimension / 2);
+pub(crate) fn sobol(key: u64, spp: u32, index: u32, dimension: u32) -> f32 {
+    let prepared = sobol_prepare(key, SobolIndex::new(index, spp), dimension / 2);
     sobol_coordinate(prepared, dimension % 2)
 }
 
-/// What both coordinates of pair `pair` share: the pair's key and the shuffled sample index.
-/// A stream keeps it, so the second coordinate of a pair read one dimension at a time costs
-/// one scramble, not three.
-#[inline]
-pub(crate) fn sobol_prepare(key: u64, index: u32, pair: u32) -> SobolPair {
-    sobol_prepare_reversed(key, index.reverse_bits(), pair)
+/// Where a sample index sits for Sobol's index shuffle: its block of `spp` indices and its
+/// place in it. A stream computes it once for all the pairs it reads.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct SobolIndex {
+    /// The sample index.
+    index: u32,
+    /// The first index of its block: `index - index % spp`.
+    start: u32,
+    /// `index % spp`.
+    local: u32,
+    /// The permutations of a block's `spp` places.
+    permutation: Permutation,
+    /// The block's number, spread over a key's bits (zero for the first block).
+    block_key: u64,
 }
 
-/// [`sobol_prepare`] given the sample index with its bits reversed, as a sample's stream
-/// holds it: the index shuffle is the Owen scramble `owen_hash(index reversed, seed)`
-/// reversed, and a stream reads several pairs of one index, so it reverses once, not once
-/// per pair.
+impl SobolIndex {
+    /// Sample `index` of a pixel sampled `spp` (at least one) times a pass.
+    #[inline]
+    pub(crate) fn new(index: u32, spp: u32) -> SobolIndex {
+        let spp = spp.max(1);
+        let block = index / spp;
+        SobolIndex {
+            index,
+            start: block * spp,
+            local: index % spp,
+            permutation: Permutation::new(spp),
+            block_key: u64::from(block).wrapping_mul(GOLDEN_ODD),
+        }
+    }
+
+    /// The index pair `pair`'s point is taken at: the sample index for the film pair, else
+    /// its place in the block permuted by the pair's key.
+    #[inline]
+    fn shuffled(self, pair: u32, pair_key: u64) -> u32 {
+        if pair == 0 {
+            self.index
+        } else {
+            // Wrapping: only a last, partial block just below 2^32 can reach past it.
+            self.start.wrapping_add(
+                self.permutation
+                    .apply(self.local, pair_key ^ self.block_key),
+            )
+        }
+    }
+}
+
+/// An odd constant (the golden ratio's fraction) that spreads a block number over a key.
+const GOLDEN_ODD: u64 = 0x9e37_79b9_7f4a_7c15;
+
+/// What both coordinates of pair `pair` share: the pair's key and the shuffled sample index.
+/// A stream keeps it, so the second coordinate of a pair read one dimension at a time costs
+/// one scramble, not a shuffle and two scrambles.
 #[inline]
-pub(crate) fn sobol_prepare_reversed(key: u64, index_reversed: u32, pair: u32) -> SobolPair {
+pub(crate) fn sobol_prepare(key: u64, at: SobolIndex, pair: u32) -> SobolPair {
     let pair_key = combine(key, u64::from(pair));
     SobolPair {
         pair,
         pair_key,
-        shuffled_reversed: owen_hash(index_reversed, pair_key as u32),
+        shuffled: at.shuffled(pair, pair_key),
     }
 }
 
@@ -269,8 +311,8 @@ pub(crate) struct SobolPair {
     /// Which pair (dimensions `2 pair` and `2 pair + 1`).
     pub pair: u32,
     pair_key: u64,
-    /// The shuffled sample index, its bits reversed ([`raw_pair_reversed`] takes it so).
-    shuffled_reversed: u32,
+    /// The shuffled sample index.
+    shuffled: u32,
 }
 
 impl SobolPair {
@@ -281,21 +323,21 @@ impl SobolPair {
     }
 }
 
-/// The key [`sobol`] and [`sobol_pair_reversed`] take: the pixel's key tagged for this sampler.
+/// The key [`sobol`] and [`sobol_pair`] take: the pixel's key tagged for this sampler.
 #[inline]
 pub(crate) fn sobol_key(pixel_key: u64) -> u64 {
     combine(pixel_key, TAG_SOBOL)
 }
 
-/// Both coordinates of pair `pair` (dimensions `2 pair` and `2 pair + 1`) of the sample whose
-/// index reversed is `index_reversed` (see [`sobol_prepare_reversed`]): the same values as two
-/// [`sobol`] calls, with the pair's key, index shuffle and raw coordinates computed once, and
-/// the two scrambled coordinates reversed together in one 64-bit reversal (hashing and bit
-/// reversal are most of the sampler's cost; see docs/performance.md).
+/// Both coordinates of pair `pair` (dimensions `2 pair` and `2 pair + 1`) of the sample at
+/// `at`: the same values as two [`sobol`] calls, with the pair's key, index shuffle and raw
+/// coordinates computed once, and the two scrambled coordinates reversed together in one
+/// 64-bit reversal (hashing and bit reversal are most of the sampler's cost; see
+/// docs/performance.md).
 #[inline]
-pub(crate) fn sobol_pair_reversed(key: u64, index_reversed: u32, pair: u32) -> [f32; 2] {
-    let prepared = sobol_prepare_reversed(key, index_reversed, pair);
-    let [raw0, raw1] = raw_pair_reversed(prepared.shuffled_reversed);
+pub(crate) fn sobol_pair(key: u64, at: SobolIndex, pair: u32) -> [f32; 2] {
+    let prepared = sobol_prepare(key, at, pair);
+    let [raw0, raw1] = raw_pair(prepared.shuffled);
     let h0 = owen_hash(raw0, prepared.scramble_seed(0));
     let h1 = owen_hash(raw1, prepared.scramble_seed(1));
     // Reversing h1:h0 as one 64-bit word puts h0 reversed in the high half, h1 reversed in
@@ -312,11 +354,11 @@ pub(crate) fn sobol_pair_reversed(key: u64, index_reversed: u32, pair: u32) -> [
 ///
 /// The raw coordinates are the van der Corput radical inverse (the index's bits reversed) and
 /// the second Sobol dimension; the scramble works on reversed bits, so both are formed
-/// reversed ([`raw_pair_reversed`]) and [`owen_hash`] reverses once: the same value as
+/// reversed ([`raw_pair`]) and [`owen_hash`] reverses once: the same value as
 /// `owen_scramble(raw, seed)` with two bit reversals fewer.
 #[inline]
 pub(crate) fn sobol_coordinate(prepared: SobolPair, which: u32) -> f32 {
-    let raw_reversed = raw_pair_reversed(prepared.shuffled_reversed)[(which & 1) as usize];
+    let raw_reversed = raw_pair(prepared.shuffled)[(which & 1) as usize];
     let scrambled = owen_hash(raw_reversed, prepared.scramble_seed(which));
     unit_f32_from_bits(scrambled.reverse_bits())
 }
@@ -355,16 +397,24 @@ mod tests {
         for _ in 0..100_000 {
             i = i.wrapping_mul(0x9e37_79b9).wrapping_add(0x7f4a_7c15);
             assert_eq!(sobol_second(i), sobol_second_bitwise(i), "index {i:#x}");
-            assert_eq!(raw_pair_reversed(i)[0], i.reverse_bits(), "index {i:#x}");
+            assert_eq!(raw_pair(i)[0], i, "index {i:#x}");
         }
     }
 
-    /// Sobol's values from their definition, one step at a time: the index shuffled by an
-    /// Owen scramble keyed per pair, the raw coordinate (van der Corput or the second Sobol
-    /// dimension, bit by bit), then its own Owen scramble.
-    fn sobol_definition(key: u64, index: u32, dimension: u32) -> f32 {
-        let pair_key = combine(key, u64::from(dimension / 2));
-        let shuffled = owen_scramble(index, pair_key as u32);
+    /// Sobol's values from their definition, one step at a time: the index's block of `spp`
+    /// and its place in it, that place permuted per pair and block (not for the film pair),
+    /// the raw coordinate (van der Corput or the second Sobol dimension, bit by bit), then its
+    /// own Owen scramble.
+    fn sobol_definition(key: u64, spp: u32, index: u32, dimension: u32) -> f32 {
+        let pair = dimension / 2;
+        let pair_key = combine(key, u64::from(pair));
+        let block = index / spp;
+        let shuffled = if pair == 0 {
+            index
+        } else {
+            let block_key = u64::from(block).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+            (block * spp).wrapping_add(permute(index % spp, spp, pair_key ^ block_key))
+        };
         let raw = if dimension.is_multiple_of(2) {
             shuffled.reverse_bits()
         } else {
@@ -376,24 +426,49 @@ mod tests {
 
     proptest::proptest! {
         #[test]
-        fn sobol_values_and_pairs_equal_the_definition(key: u64, index: u32, pair in 0u32..1000) {
-            let expected = [
-                sobol_definition(key, index, 2 * pair),
-                sobol_definition(key, index, 2 * pair + 1),
-            ];
-            proptest::prop_assert_eq!(
-                [sobol(key, index, 2 * pair), sobol(key, index, 2 * pair + 1)],
-                expected
-            );
-            proptest::prop_assert_eq!(sobol_pair_reversed(key, index.reverse_bits(), pair), expected);
+        fn sobol_values_and_pairs_equal_the_definition(
+            key: u64,
+            spp in 1u32..5000,
+            index: u32,
+            pair in 0u32..1000,
+        ) {
+            // The film pair, which is not shuffled, every time; another pair at random.
+            for pair in [0, pair] {
+                let expected = [
+                    sobol_definition(key, spp, index, 2 * pair),
+                    sobol_definition(key, spp, index, 2 * pair + 1),
+                ];
+                proptest::prop_assert_eq!(
+                    [sobol(key, spp, index, 2 * pair), sobol(key, spp, index, 2 * pair + 1)],
+                    expected
+                );
+                proptest::prop_assert_eq!(
+                    sobol_pair(key, SobolIndex::new(index, spp), pair),
+                    expected
+                );
+            }
         }
 
         #[test]
         fn raw_pair_tables_equal_the_bitwise_definition(shuffled: u32) {
             proptest::prop_assert_eq!(
-                raw_pair_reversed(shuffled.reverse_bits()),
+                raw_pair(shuffled),
                 [shuffled, sobol_second_bitwise(shuffled).reverse_bits()]
             );
+        }
+
+        #[test]
+        fn sobol_shuffles_each_block_onto_itself(key: u64, spp in 1u32..300, block in 0u32..4, pair in 0u32..20) {
+            // The pair's points of one block are the block's own indices, each once.
+            let at = |i| SobolIndex::new(block * spp + i, spp);
+            let mut seen = vec![false; spp as usize];
+            for i in 0..spp {
+                let shuffled = sobol_prepare(key, at(i), pair).shuffled;
+                proptest::prop_assert!((block * spp..(block + 1) * spp).contains(&shuffled));
+                let slot = &mut seen[(shuffled - block * spp) as usize];
+                proptest::prop_assert!(!*slot, "index {} twice", shuffled);
+                *slot = true;
+            }
         }
     }
 

@@ -80,10 +80,11 @@ fn stratified_grid_hand_cases() {
 #[test]
 fn sobol_fills_every_elementary_interval_at_powers_of_two() {
     for seed in [0, 5] {
-        let s = sampler(SamplerKind::Sobol, 1024, seed);
         for pixel in [[0, 0], [3, 9], [640, 480]] {
-            for pair in 0..5 {
-                for m in 0..=10u32 {
+            for m in 0..=10u32 {
+                // At 2^m spp every pair's pass is a (0,m,2)-net.
+                let s = sampler(SamplerKind::Sobol, 1 << m, seed);
+                for pair in 0..5 {
                     for a in 0..=m {
                         assert_one_per_cell(
                             &s,
@@ -94,15 +95,20 @@ fn sobol_fills_every_elementary_interval_at_powers_of_two() {
                         );
                     }
                 }
+                // The film pair is not shuffled, so at any spp its first 2^m samples are one.
+                let s = sampler(SamplerKind::Sobol, 1000, seed);
+                for a in 0..=m {
+                    assert_one_per_cell(&s, pixel, 0, [0, 1], [1 << a, 1 << (m - a)]);
+                }
             }
         }
     }
 }
 
 #[test]
-fn sobol_later_power_of_two_blocks_are_nets_too() {
-    // Samples 16..32 of a 32-spp pixel are the second half: again one per 4x4 cell.
-    let s = sampler(SamplerKind::Sobol, 32, 3);
+fn sobol_later_passes_are_nets_too() {
+    // Samples 16..32 of a 16-spp pixel are its second pass: again one per 4x4 cell.
+    let s = sampler(SamplerKind::Sobol, 16, 3);
     for pair in 0..4 {
         assert_one_per_cell(&s, [7, 7], 16, [2 * pair, 2 * pair + 1], [4, 4]);
         assert_one_per_cell(&s, [7, 7], 16, [2 * pair, 2 * pair + 1], [2, 8]);
