@@ -1,5 +1,6 @@
 """Time to equal error: Obscura against Mitsuba 3 on the comparison scenes (`compare.py --only
-error`, or this file alone: `python3 bench/equal_error.py [--scenes box,env] [--spp 16,64,256]`).
+error`, or this file alone: `python3 bench/equal_error.py [--scenes box,env] [--spp 16,64,256]
+[--seeds 2]`).
 
 Equal samples per pixel say little when the two renderers' images are not equally noisy. Here each
 scene is one Mitsuba 3 XML file that both renderers read (Obscura through its Mitsuba importer,
@@ -22,6 +23,9 @@ efficiencies is the ratio of their times to the same error.
   Mitsuba with its defaults (independent sampler, Russian roulette from depth 5) in scalar_rgb and
   llvm_ad_rgb, and llvm_ad_rgb with `ldsampler` and, when Obscura's roulette starts elsewhere
   than Mitsuba's default, with Obscura's start ("fair RR").
+* Spread: each ratio is printed with the range of one standard error, from the scatter of the
+  seeds' times and errors at each spp (`--seeds`, two by default). A scene whose error has a
+  heavy tail (env: the sun seen through glass) needs more seeds than two to pin its ratio down.
 
 Scenes: `spheres` (scenes/spheres-perspective.xml, the comparison scene of `--only render`),
 `box` (bench/scenes/box.xml: a Cornell box with a quad light, diffuse, mirror and glass spheres),
@@ -274,6 +278,16 @@ def reference(name, xml, threads, variant):
     return ref, own
 
 
+def relative_variance_of_mean(values):
+    """The squared standard error of the values' mean over the mean (0 for one value)."""
+    import numpy as np
+
+    if len(values) < 2:
+        return 0.0
+    mean = float(np.mean(values))
+    return float(np.var(values, ddof=1) / len(values)) / (mean * mean)
+
+
 def rel_mse(image, other, ref):
     import numpy as np
 
@@ -335,17 +349,29 @@ def run(scenes, spps, threads, seeds_per_spp=2):
             # The efficiency of a configuration: total samples' time over total error, each
             # spp weighted alike (times and MSEs averaged over the seeds first).
             effs = []
+            log_variances = []
             for spp in spps:
                 pts = [p for p in config["points"] if p["spp"] == spp]
-                effs.append(1.0 / (np.mean([p["time_s"] for p in pts])
-                                   * np.mean([p["rel_mse"] for p in pts])))
+                times = [p["time_s"] for p in pts]
+                mses = [p["rel_mse"] for p in pts]
+                effs.append(1.0 / (np.mean(times) * np.mean(mses)))
+                log_variances.append(relative_variance_of_mean(times)
+                                     + relative_variance_of_mean(mses))
             config["efficiency"] = float(np.exp(np.mean(np.log(effs))))
-        ours = scene_result["configs"][0]["efficiency"]
-        print("  time to equal error, Obscura (Sobol) / peer (below 1.0: Obscura is faster):")
+            # The standard error of log(efficiency): the mean of the spps' logs, each log's
+            # variance about the squared relative standard error of its seeds' mean (delta
+            # method). From two seeds it is itself rough; it says which ratios are ties.
+            config["log_efficiency_se"] = float(np.sqrt(np.sum(log_variances)) / len(spps))
+        ours = scene_result["configs"][0]
+        print("  time to equal error, Obscura (Sobol) / peer (below 1.0: Obscura is faster),")
+        print("  with the range of one standard error from the seeds' scatter:")
         for config in scene_result["configs"][1:]:
-            ratio = config["efficiency"] / ours
+            ratio = config["efficiency"] / ours["efficiency"]
+            se = float(np.hypot(config["log_efficiency_se"], ours["log_efficiency_se"]))
             config["obscura_time_ratio"] = ratio
-            print(f"    {config['label']:<28}{ratio:>7.2f}")
+            config["obscura_time_ratio_range"] = [ratio * np.exp(-se), ratio * np.exp(se)]
+            print(f"    {config['label']:<28}{ratio:>7.2f}  "
+                  f"({ratio * np.exp(-se):.2f}-{ratio * np.exp(se):.2f})")
         results.append(scene_result)
     return results
 
@@ -381,9 +407,12 @@ def main():
     parser.add_argument("--scenes", default=",".join(SCENES))
     parser.add_argument("--spp", default="16,64,256")
     parser.add_argument("--threads", type=int, default=2)
+    parser.add_argument("--seeds", type=int, default=2,
+                        help="renders per configuration and spp (seeds 0, 1, ...)")
     parser.add_argument("--out", default=str(ROOT / "bench" / "results-error.json"))
     args = parser.parse_args()
-    results = run(args.scenes.split(","), [int(s) for s in args.spp.split(",")], args.threads)
+    results = run(args.scenes.split(","), [int(s) for s in args.spp.split(",")], args.threads,
+                  args.seeds)
     Path(args.out).write_text(json.dumps(results, indent=2))
 
 
