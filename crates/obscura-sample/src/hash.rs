@@ -3,8 +3,9 @@
 //! Everything here is a pure function of its arguments, so every sample value is a pure
 //! function of (pixel, sample index, dimension, seed).
 
-/// The golden-ratio increment of splitmix64, used to separate successive keys.
-const GOLDEN: u64 = 0x9e37_79b9_7f4a_7c15;
+/// The golden-ratio increment of splitmix64, used to separate successive keys (odd, so
+/// multiplying by it also spreads a counter over a key's bits).
+pub(crate) const GOLDEN: u64 = 0x9e37_79b9_7f4a_7c15;
 
 /// The largest `f32` below one: every canonical sample value is at most this.
 pub const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;

@@ -7,7 +7,7 @@ use rand_core::Rng;
 use rand_pcg::Pcg32;
 
 use crate::hash::{
-    Permutation, combine, in_stratum, mix64, owen_hash, permute, unit_f32_from_bits,
+    GOLDEN, Permutation, combine, in_stratum, mix64, owen_hash, permute, unit_f32_from_bits,
     unit_f64_from_bits,
 };
 
@@ -221,7 +221,7 @@ pub(crate) const fn sobol_second_bitwise(mut index: u32) -> u32 {
 
 /// Padded, Owen-scrambled Sobol: each pair of dimensions `(2p, 2p + 1)` is the 2D
 /// (0,2)-sequence (van der Corput, second Sobol dimension), its sample index shuffled per
-/// (pixel, pair) and each coordinate Owen-scrambled per (pixel, pair, coordinate).
+/// (pixel, pair, pass) and each coordinate Owen-scrambled per (pixel, pair, coordinate).
 ///
 /// The index shuffle is a pseudo-random permutation ([`permute`]) of each block of `spp`
 /// consecutive indices (a pass over the pixel's samples) onto itself, drawn per (pixel, pair,
@@ -269,7 +269,7 @@ impl SobolIndex {
             start: block * spp,
             local: index % spp,
             permutation: Permutation::new(spp),
-            block_key: u64::from(block).wrapping_mul(GOLDEN_ODD),
+            block_key: u64::from(block).wrapping_mul(GOLDEN),
         }
     }
 
@@ -288,9 +288,6 @@ impl SobolIndex {
         }
     }
 }
-
-/// An odd constant (the golden ratio's fraction) that spreads a block number over a key.
-const GOLDEN_ODD: u64 = 0x9e37_79b9_7f4a_7c15;
 
 /// What both coordinates of pair `pair` share: the pair's key and the shuffled sample index.
 /// A stream keeps it, so the second coordinate of a pair read one dimension at a time costs
