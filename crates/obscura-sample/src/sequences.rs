@@ -1,4 +1,5 @@
-//! The four sample generators, each a pure function of (pixel key, sample index, dimension).
+//! The four sample generators, each a pure function of (pixel key, sample index, dimension)
+//! for a given number of samples per pixel.
 //!
 //! The pixel key is [`crate::hash::pixel_key`] of (seed, pixel); everything else that varies
 //! per pixel, per dimension or per pair of dimensions is hashed from it here.
