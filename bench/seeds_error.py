@@ -60,9 +60,8 @@ def main():
                 times[label].append(seconds)
         for label, _ in builds:
             m = statistics.fmean(mses[label])
-            # Standard error of the mean MSE, halved: the relative error of its square root.
-            spread = (statistics.stdev(mses[label]) / len(mses[label]) ** 0.5 / m / 2
-                      if len(mses[label]) > 1 else float("nan"))
+            # The mean MSE's relative standard error, halved: that of its square root.
+            spread = harness.relative_variance_of_mean(mses[label]) ** 0.5 / 2
             print(f"{name} {label}: {args.sampler}, {args.spp} spp, {args.seeds} seeds: "
                   f"rel RMSE {m ** 0.5:.4f} +- {100 * spread:.1f}%, "
                   f"median time {statistics.median(times[label]):.3f} s")

@@ -59,12 +59,12 @@ pub(crate) fn permute(i: u32, n: u32, key: u64) -> u32 {
 /// xorshifts, all invertible modulo `2^bits`) is iterated until it lands below `n` ("cycle
 /// walking"); the restriction of a permutation to a subset by cycle walking is again a
 /// permutation. Expected iterations are below two because `n > 2^bits / 2`.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct Permutation {
     n: u32,
-    bits: u32,
     mask: u32,
     shift: u32,
+    last_shift: u32,
 }
 
 impl Permutation {
@@ -78,10 +78,16 @@ impl Permutation {
         };
         Permutation {
             n,
-            bits,
             mask: u32::MAX.checked_shr(32 - bits).unwrap_or(0),
             shift: (bits / 2).max(1),
+            last_shift: bits.div_ceil(2).max(1),
         }
+    }
+
+    /// `n`: how many places are permuted.
+    #[inline]
+    pub(crate) fn len(self) -> u32 {
+        self.n
     }
 
     /// Where the permutation chosen by `key` takes `i` (which must be `< n`).
@@ -89,9 +95,9 @@ impl Permutation {
     pub(crate) fn apply(self, i: u32, key: u64) -> u32 {
         let Permutation {
             n,
-            bits,
             mask,
             shift,
+            last_shift,
         } = self;
         if n <= 1 {
             return 0;
@@ -109,7 +115,7 @@ impl Permutation {
             x = x.wrapping_add(k2) & mask;
             x ^= x >> shift;
             x = x.wrapping_mul(0x297a_2d39) & mask;
-            x ^= x >> (bits.div_ceil(2)).max(1);
+            x ^= x >> last_shift;
             if x < n {
                 return x;
             }

@@ -7,7 +7,7 @@ use std::str::FromStr;
 use glam::Vec2;
 
 use crate::error::SampleError;
-use crate::hash::pixel_key;
+use crate::hash::{Permutation, pixel_key};
 use crate::sequences;
 
 /// The largest number of samples per pixel: `2^24`, so that every stratum of every
@@ -85,6 +85,8 @@ pub struct Sampler {
     samples_per_pixel: u32,
     seed: u64,
     grid: [u32; 2],
+    /// Sobol's permutations of a pass's `samples_per_pixel` places, built once.
+    sobol_places: Permutation,
 }
 
 impl Sampler {
@@ -109,6 +111,7 @@ impl Sampler {
             samples_per_pixel,
             seed,
             grid: sequences::stratified_grid(samples_per_pixel),
+            sobol_places: Permutation::new(samples_per_pixel),
         })
     }
 
@@ -169,9 +172,7 @@ impl Sampler {
                 dimension,
             ),
             SamplerKind::Halton => sequences::halton(pixel_key, index, dimension),
-            SamplerKind::Sobol => {
-                sequences::sobol(pixel_key, self.samples_per_pixel, index, dimension)
-            }
+            SamplerKind::Sobol => sequences::sobol(pixel_key, self.sobol_places, index, dimension),
         }
     }
 
@@ -182,7 +183,7 @@ impl Sampler {
             sampler: self,
             pixel_key: self.key(pixel),
             index,
-            sobol_index: sequences::SobolIndex::new(index, self.samples_per_pixel),
+            sobol_index: sequences::SobolIndex::new(index, self.sobol_places),
             dimension: 0,
             sobol_last: None,
         }

@@ -229,18 +229,20 @@ pub(crate) const fn sobol_second_bitwise(mut index: u32) -> u32 {
 /// block), as pbrt-v4's padded Sobol sampler and Mitsuba 3's `ldsampler` do; the film pair
 /// (`p = 0`) is not shuffled, so every other pair is paired with the film by one permutation
 /// of the hash family, which renders measured better than a uniformly random pairing (and
-/// than a composition of two). Each block holds the same points as before its shuffle, so when `spp = 2^m`
-/// every pair of every block is a (0,m,2)-net (one point in each elementary interval of area
-/// `2^-m`; Owen scrambling keeps nets), and the film's first `2^k` samples are nets too.
+/// than a composition of two). Each block holds the same points as before its shuffle, so
+/// when `spp = 2^m` every pair of every block is a (0,m,2)-net (one point in each elementary
+/// interval of area `2^-m`; Owen scrambling keeps nets), and the film's first `2^k` samples
+/// are nets too.
 ///
 /// Not a nested scramble of the index bits, although that would keep every pair's first `2^k`
 /// samples nets as well: it pairs the strata of different pairs with a structure of its own,
 /// which renders measured noisier (docs/performance.md, "The Sobol sampler's index shuffle").
 ///
-/// `key` is the pixel's key tagged for Sobol by [`sobol_key`] (once per pixel, not per value).
+/// `key` is the pixel's key tagged for Sobol by [`sobol_key`] (once per pixel, not per value);
+/// `places` is [`Permutation::new`] of the samples per pixel, which the sampler builds once.
 #[inline]
-pub(crate) fn sobol(key: u64, spp: u32, index: u32, dimension: u32) -> f32 {
-    let prepared = sobol_prepare(key, SobolIndex::new(index, spp), dimension / 2);
+pub(crate) fn sobol(key: u64, places: Permutation, index: u32, dimension: u32) -> f32 {
+    let prepared = sobol_prepare(key, SobolIndex::new(index, places), dimension / 2);
     sobol_coordinate(prepared, dimension % 2)
 }
 
@@ -248,8 +250,6 @@ pub(crate) fn sobol(key: u64, spp: u32, index: u32, dimension: u32) -> f32 {
 /// place in it. A stream computes it once for all the pairs it reads.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct SobolIndex {
-    /// The sample index.
-    index: u32,
     /// The first index of its block: `index - index % spp`.
     start: u32,
     /// `index % spp`.
@@ -261,16 +261,16 @@ pub(crate) struct SobolIndex {
 }
 
 impl SobolIndex {
-    /// Sample `index` of a pixel sampled `spp` (at least one) times a pass.
+    /// Sample `index` of a pixel sampled `permutation.len()` (at least one) times a pass;
+    /// `permutation` permutes a pass's places.
     #[inline]
-    pub(crate) fn new(index: u32, spp: u32) -> SobolIndex {
-        let spp = spp.max(1);
+    pub(crate) fn new(index: u32, permutation: Permutation) -> SobolIndex {
+        let spp = permutation.len().max(1);
         let block = index / spp;
         SobolIndex {
-            index,
             start: block * spp,
             local: index % spp,
-            permutation: Permutation::new(spp),
+            permutation,
             block_key: u64::from(block).wrapping_mul(GOLDEN),
         }
     }
@@ -280,7 +280,7 @@ impl SobolIndex {
     #[inline]
     fn shuffled(self, pair: u32, pair_key: u64) -> u32 {
         if pair == 0 {
-            self.index
+            self.start + self.local
         } else {
             // Wrapping: only a last, partial block just below 2^32 can reach past it.
             self.start.wrapping_add(
@@ -438,11 +438,14 @@ mod tests {
                     sobol_definition(key, spp, index, 2 * pair + 1),
                 ];
                 proptest::prop_assert_eq!(
-                    [sobol(key, spp, index, 2 * pair), sobol(key, spp, index, 2 * pair + 1)],
+                    [
+                        sobol(key, Permutation::new(spp), index, 2 * pair),
+                        sobol(key, Permutation::new(spp), index, 2 * pair + 1),
+                    ],
                     expected
                 );
                 proptest::prop_assert_eq!(
-                    sobol_pair(key, SobolIndex::new(index, spp), pair),
+                    sobol_pair(key, SobolIndex::new(index, Permutation::new(spp)), pair),
                     expected
                 );
             }
@@ -459,7 +462,7 @@ mod tests {
         #[test]
         fn sobol_shuffles_each_block_onto_itself(key: u64, spp in 1u32..300, block in 0u32..4, pair in 0u32..20) {
             // The pair's points of one block are the block's own indices, each once.
-            let at = |i| SobolIndex::new(block * spp + i, spp);
+            let at = |i| SobolIndex::new(block * spp + i, Permutation::new(spp));
             let mut seen = vec![false; spp as usize];
             for i in 0..spp {
                 let shuffled = sobol_prepare(key, at(i), pair).shuffled;
