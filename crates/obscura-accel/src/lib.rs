@@ -76,3 +76,4 @@ pub use obj::{load_obj, parse_obj};
 pub use pages::Pages;
 pub use scene::{BuildQuality, MAX_COORDINATE, PreliminaryHit, Scene, SceneBuilder};
 pub use shape::{Placement, Shape};
+pub use simd::prefetch;

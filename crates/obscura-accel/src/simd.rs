@@ -4,14 +4,15 @@
 //! query ([`WideBvh::closest_batch`](crate::wide)) asks for the lines of the node a ray will
 //! visit next and then works on other rays while they arrive; a plain load in its place
 //! would hold up the retirement of everything behind it until the line came, which is what
-//! the batch exists to avoid. A prefetch is a hint: it never faults and never changes what a
+//! the batch exists to avoid. The path tracer asks ahead in the same way for the environment
+//! map's cells a round of paths will read. A prefetch is a hint: it never faults and never changes what a
 //! later load returns, so the portable path (no instruction at all) gives the same results.
 #![allow(unsafe_code)]
 
 /// Asks for the cache line holding `*item` and the `extra_lines` lines after it, into every
 /// cache level. Never changes a result; a no-op on targets without the instruction.
 #[inline(always)]
-pub(crate) fn prefetch<T>(item: &T, extra_lines: usize) {
+pub fn prefetch<T>(item: &T, extra_lines: usize) {
     #[cfg(any(
         target_arch = "x86_64",
         all(target_arch = "x86", target_feature = "sse")

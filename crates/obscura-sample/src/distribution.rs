@@ -325,6 +325,29 @@ pub struct Distribution2D<S = Vec<GridCell>> {
     marginal: Distribution1D,
 }
 
+/// Where a sample of a [`Distribution2D`] starts its search within the row it picked, from
+/// [`Distribution2D::search_start`]: two loads, one after the other, that a caller can ask
+/// the cache for ahead of the sample, in turn.
+#[derive(Debug, Clone, Copy)]
+pub struct SearchStart<'a> {
+    cells: &'a [GridCell],
+    bucket: usize,
+}
+
+impl<'a> SearchStart<'a> {
+    /// The cell holding the guide entry the search reads first (not read here).
+    #[inline]
+    pub fn guide_cell(&self) -> &'a GridCell {
+        &self.cells[self.bucket]
+    }
+
+    /// The first cell the search then compares, found by reading the guide entry.
+    #[inline]
+    pub fn searched_cell(&self) -> &'a GridCell {
+        &self.cells[self.cells[self.bucket].bin().guide as usize]
+    }
+}
+
 impl Distribution2D {
     /// From row-major weights (`weights[y * width + x]`); `weights.len()` must be `width * height`.
     /// Every cell's value is zero.
@@ -409,6 +432,25 @@ impl<S: Deref<Target = [GridCell]>> Distribution2D<S> {
         let (v, pdf_v, y) = self.marginal.sample_continuous(u2.y);
         let (u, pdf_u, _) = self.row_at(y).sample_continuous(u2.x);
         (Vec2::new(u, v), pdf_u * pdf_v)
+    }
+
+    /// Where [`Distribution2D::sample`]'s search for `u2` starts, without reading the grid:
+    /// its first load, which nothing before it predicts, for a caller to prefetch.
+    #[inline]
+    pub fn search_start(&self, u2: Vec2) -> SearchStart<'_> {
+        let row = self.row_at(self.marginal.row().find(u2.y));
+        SearchStart {
+            cells: row.cells,
+            bucket: bucket(u2.x, row.len()),
+        }
+    }
+
+    /// The grid cell holding `p` in `[0, 1)^2` (clamped): the one that
+    /// [`Distribution2D::pdf_and_value`] reads.
+    #[inline]
+    pub fn cell(&self, p: Vec2) -> &GridCell {
+        let row = self.row(p.y);
+        &row.cells[row.bin(p.x)]
     }
 
     /// [`Distribution2D::sample`] with the value of the grid cell holding the point.
@@ -541,7 +583,16 @@ mod tests {
             let (x, y) = ((p.x * w as f32) as u32, (p.y * h as f32) as u32);
             prop_assert_eq!(value, Vec3::new((y * w as u32 + x) as f32, 0.0, -1.0));
             prop_assert_eq!(d.pdf_and_value(p), (pdf, value));
+            prop_assert_eq!(d.cell(p).value, value.to_array());
             prop_assert_eq!(Distribution2D::new(&weights, w, h).sample(Vec2::new(ux, uy)), (p, pdf));
+            // The cells to prefetch are the guide entry the sample reads in the row it picks,
+            // and the first cell its search then compares.
+            let row = d.row_at(d.marginal.sample_continuous(uy).2);
+            let start = d.search_start(Vec2::new(ux, uy));
+            prop_assert!(std::ptr::eq(start.guide_cell(), &row.cells[bucket(ux, w)]));
+            let lo = row.cells[bucket(ux, w)].bin().guide as usize;
+            prop_assert!(std::ptr::eq(start.searched_cell(), &row.cells[lo]));
+            prop_assert!(lo <= row.count_at_or_below(ux));
         }
 
         #[test]

@@ -56,7 +56,7 @@ mod shutter;
 mod trig;
 mod warp;
 
-pub use distribution::{Distribution1D, Distribution2D, GridCell};
+pub use distribution::{Distribution1D, Distribution2D, GridCell, SearchStart};
 pub use error::SampleError;
 pub use hash::ONE_MINUS_EPSILON;
 pub use sampler::{MAX_SAMPLES_PER_PIXEL, SampleStream, Sampler, SamplerKind};

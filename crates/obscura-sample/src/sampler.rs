@@ -292,6 +292,22 @@ impl SampleStream<'_> {
         }
     }
 
+    /// The value [`SampleStream::next_1d`] would return, without moving the cursor: for a
+    /// caller that prepares for a decision before it makes it.
+    #[inline]
+    pub fn peek_1d(&self) -> f32 {
+        self.sampler
+            .value_keyed(self.pixel_key, self.index, self.dimension)
+    }
+
+    /// The pair [`SampleStream::next_2d`] would return after `skip` calls of
+    /// [`SampleStream::skip_1d`], without moving the cursor.
+    #[inline]
+    pub fn peek_2d(&self, skip: u32) -> Vec2 {
+        let first = self.dimension.saturating_add(skip);
+        self.pair(first.saturating_add(first % 2))
+    }
+
     /// The next aligned pair of dimensions, in `[0, 1)^2`.
     #[inline]
     pub fn next_2d(&mut self) -> Vec2 {
@@ -359,6 +375,41 @@ mod tests {
                     );
                 }
             }
+        }
+    }
+
+    proptest::proptest! {
+        #[test]
+        fn peeks_return_the_next_values_and_move_nothing(
+            kind_index in 0usize..SamplerKind::ALL.len(),
+            steps in proptest::collection::vec(0u8..3, 0..12),
+            skip in 0u32..4,
+            index in 0u32..64,
+        ) {
+            // After any mix of reads, a peek gives what the read it stands for would give,
+            // and the reads after it are those without the peek.
+            let kind = SamplerKind::ALL[kind_index];
+            let sampler = Sampler::new(kind, 64, 9).unwrap();
+            let mut stream = sampler.stream([5, 11], index);
+            stream.camera();
+            for step in steps {
+                match step {
+                    0 => { stream.next_1d(); }
+                    1 => stream.skip_1d(),
+                    _ => { stream.next_2d(); }
+                }
+            }
+            let (one, two) = (stream.peek_1d(), stream.peek_2d(skip));
+            let mut reader = stream.clone();
+            proptest::prop_assert_eq!(one.to_bits(), reader.next_1d().to_bits());
+            let mut reader = stream.clone();
+            for _ in 0..skip {
+                reader.skip_1d();
+            }
+            let expected = reader.next_2d();
+            proptest::prop_assert_eq!(two.to_array().map(f32::to_bits), expected.to_array().map(f32::to_bits));
+            let mut unpeeked = stream.clone();
+            proptest::prop_assert_eq!(stream.next_2d(), unpeeked.next_2d());
         }
     }
 

@@ -7,7 +7,7 @@ use crate::light::{AreaLight, Light};
 use crate::material::Material;
 use glam::{Vec2, Vec3};
 use obscura_accel::{Hit, Placement, Scene, Shape};
-use obscura_sample::SampleStream;
+use obscura_sample::{SampleStream, SearchStart};
 use obscura_space::{Ray, Vector3, World};
 
 /// The canonical numbers a path consumes, one shading decision after another. Implemented by
@@ -17,6 +17,18 @@ pub trait SampleDims {
     fn next_1d(&mut self) -> f32;
     /// The next pair in `[0, 1)^2`.
     fn next_2d(&mut self) -> Vec2;
+    /// The number [`SampleDims::next_1d`] would return, without moving past it; `None` if the
+    /// generator cannot look ahead (nothing then is prepared ahead of time).
+    fn peek_1d(&mut self) -> Option<f32> {
+        None
+    }
+    /// The pair [`SampleDims::next_2d`] would return after `skip` calls of
+    /// [`SampleDims::skip_1d`], without moving past anything; `None` if the generator cannot
+    /// look ahead.
+    fn peek_2d(&mut self, skip: u32) -> Option<Vec2> {
+        let _ = skip;
+        None
+    }
     /// Moves past the next number, which nothing would read: the numbers after it must be
     /// the same as after [`SampleDims::next_1d`]. The default draws it and drops it.
     fn skip_1d(&mut self) {
@@ -48,6 +60,14 @@ impl SampleDims for SampleStream<'_> {
     fn skip_1d(&mut self) {
         SampleStream::skip_1d(self)
     }
+    #[inline]
+    fn peek_1d(&mut self) -> Option<f32> {
+        Some(SampleStream::peek_1d(self))
+    }
+    #[inline]
+    fn peek_2d(&mut self, skip: u32) -> Option<Vec2> {
+        Some(SampleStream::peek_2d(self, skip))
+    }
 }
 
 /// Everything the path tracer needs besides the geometry: materials per instance, and lights
@@ -61,6 +81,8 @@ pub struct ShadingScene {
     instance_light: Vec<Option<u32>>,
     /// Indices in `lights` of the environment lights (seen by rays that escape).
     environment: Vec<u32>,
+    /// Whether an environment light is a map, whose lookups read memory at random.
+    environment_map: bool,
 }
 
 impl ShadingScene {
@@ -116,12 +138,16 @@ impl ShadingScene {
             .filter(|(_, l)| matches!(l, Light::Environment(_)))
             .map(|(i, _)| i as u32)
             .collect();
+        let environment_map = lights
+            .iter()
+            .any(|l| matches!(l, Light::Environment(env) if env.is_map()));
         Ok(ShadingScene {
             materials,
             instance_material,
             lights,
             instance_light,
             environment,
+            environment_map,
         })
     }
 
@@ -155,6 +181,12 @@ impl ShadingScene {
                 _ => Vec3::ZERO,
             })
             .sum()
+    }
+
+    /// Whether one of the lights is an environment map: a light sample or an escaped path
+    /// then reads its large table at a random place.
+    pub fn has_environment_map(&self) -> bool {
+        self.environment_map
     }
 
     /// The probability with which next-event estimation picks any one light (uniform choice).
@@ -249,7 +281,13 @@ impl PathIntegrator {
     /// (bit for bit) what `li_and_hit` gives for it. The paths advance together, one vertex
     /// each per round, so each round's rays go through the geometry as one batch
     /// ([`Scene::intersect_batch`], [`Scene::occluded_batch`]), which on a large mesh overlaps
-    /// their cache misses. Each path's arithmetic is the one-path loop's, in the same order.
+    /// their cache misses. With an environment map, each round first asks the cache for the
+    /// map's cells its vertices will read (the escaped paths' lookups, the light samples'
+    /// first loads, from numbers peeked ahead), so that those misses overlap too. Each path's
+    /// arithmetic is the one-path loop's, in the same order.
+    ///
+    /// A scene with neither a large mesh nor an environment map has nothing to overlap: its
+    /// paths are traced one at a time, which costs fewer instructions.
     pub fn li_and_hit_batch<D: SampleDims>(
         &self,
         geometry: &Scene,
@@ -257,7 +295,7 @@ impl PathIntegrator {
         rays: &[Ray<World>],
         dims: &mut [D],
     ) -> Vec<(Vec3, bool)> {
-        if !geometry.batches() {
+        if !geometry.batches() && !shading.has_environment_map() {
             return rays
                 .iter()
                 .zip(dims)
@@ -275,10 +313,27 @@ impl PathIntegrator {
         let mut pending: Vec<(usize, Shadow)> = Vec::new();
         let mut shadow_rays = Vec::new();
         let mut going_on = Vec::with_capacity(live.len());
+        let mut searches = Vec::new();
         while !live.is_empty() {
             next_rays.clear();
             next_rays.extend(live.iter().map(|(_, path)| path.ray));
             let hits = geometry.intersect_batch(&next_rays);
+            if shading.has_environment_map() {
+                // Ask for the map's cells in two sweeps: the lines each vertex reads first,
+                // then, once the guide entries have come, the cells the searches compare.
+                searches.clear();
+                for ((slot, path), hit) in live.iter().zip(&hits) {
+                    searches.extend(self.prefetch_vertex(
+                        shading,
+                        path,
+                        hit.as_ref(),
+                        &mut dims[*slot],
+                    ));
+                }
+                for search in &searches {
+                    obscura_accel::prefetch(search.searched_cell(), 0);
+                }
+            }
             going_on.clear();
             for (k, ((slot, path), hit)) in live.iter_mut().zip(hits).enumerate() {
                 let (shadow, more) = self.vertex(shading, path, hit, &mut dims[*slot]);
@@ -453,6 +508,49 @@ impl PathIntegrator {
 
     /// One light sample at `hit`, MIS-weighted against BSDF sampling: its value if nothing
     /// blocks it, and the shadow ray that decides that; `None` for a sample worth nothing.
+    /// Asks the cache for the environment map's cell that the path's coming vertex at `hit`
+    /// will read first: the escaped ray's lookup, or the guide entry of the light sample's
+    /// search (when the vertex will sample a light and the peeked numbers pick the map), whose
+    /// start it returns. Draws no number and changes no result.
+    #[inline]
+    fn prefetch_vertex<'s>(
+        &self,
+        shading: &'s ShadingScene,
+        path: &PathState,
+        hit: Option<&Hit>,
+        dims: &mut impl SampleDims,
+    ) -> Option<SearchStart<'s>> {
+        let Some(hit) = hit else {
+            for &i in &shading.environment {
+                if let Light::Environment(env) = &shading.lights[i as usize] {
+                    env.prefetch_lookup(path.ray.direction.to_glam());
+                }
+            }
+            return None;
+        };
+        // The vertex samples a light only below the depth limit, on a non-specular material.
+        let samples_light = path.depth < self.max_depth
+            && shading
+                .material(hit.instance)
+                .is_some_and(|m| !m.is_specular());
+        if !samples_light {
+            return None;
+        }
+        // Its numbers: the light's choice (drawn only among several), then the pair.
+        let count = shading.lights.len();
+        let index = if count > 1 {
+            light_index(dims.peek_1d()?, count)
+        } else {
+            0
+        };
+        let Some(Light::Environment(env)) = shading.lights.get(index) else {
+            return None;
+        };
+        let start = env.sample_start(dims.peek_2d(1)?)?;
+        obscura_accel::prefetch(start.guide_cell(), 0);
+        Some(start)
+    }
+
     #[inline(always)]
     fn sample_light(
         &self,
@@ -465,7 +563,7 @@ impl PathIntegrator {
         u2_light: Vec2,
     ) -> Option<(Vec3, Ray<World>)> {
         let count = shading.lights.len();
-        let index = ((u_light * count as f32) as usize).min(count - 1);
+        let index = light_index(u_light, count);
         let light_select = 1.0 / count as f32;
         let p = hit.p.to_glam();
         let ls = shading.lights[index].sample_li(p, hit.time, u2_light)?;
@@ -495,6 +593,12 @@ impl PathIntegrator {
 
 /// A path under way: its next ray, throughput and radiance so far, and what MIS needs of the
 /// previous scattering.
+/// The light that number `u` in `[0, 1)` picks among `count` (at least one), uniformly.
+#[inline(always)]
+fn light_index(u: f32, count: usize) -> usize {
+    ((u * count as f32) as usize).min(count - 1)
+}
+
 #[derive(Clone, Copy, Debug)]
 struct PathState {
     ray: Ray<World>,

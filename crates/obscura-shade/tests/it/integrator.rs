@@ -694,3 +694,48 @@ fn paths_traced_together_equal_paths_traced_one_by_one() {
     let missed = together.iter().filter(|v| !v.1).count();
     assert!(lit > 2000 && missed > 0, "{lit} lit, {missed} missed");
 }
+
+#[test]
+fn paths_traced_together_under_an_environment_map_equal_paths_traced_one_by_one() {
+    // With an environment map, a scene without a large mesh also takes the batched path, which
+    // prefetches the map's cells from numbers it peeks ahead in the sample streams. Peeking
+    // must draw nothing and prefetching change nothing: every value is the one-path loop's,
+    // bit for bit, with the renderer's own Sobol streams (which can peek).
+    let scene = every_material_and_light(floor(Material::Diffuse {
+        reflectance: Vec3::splat(0.7),
+    }));
+    assert!(!scene.0.batches() && scene.1.has_environment_map());
+    let sampler = obscura_sample::Sampler::new(obscura_sample::SamplerKind::Sobol, 16, 3).unwrap();
+    let integrator = PathIntegrator::new(12);
+    let mut rng = Rng::new(8);
+    let rays: Vec<Ray<World>> = (0..2000)
+        .map(|_| {
+            let origin = Vec3::new(0.0, 3.0, 7.0) + rng.direction() * 0.5;
+            ray(origin, rng.direction() + Vec3::new(0.0, -0.2, -1.0), 0.0)
+        })
+        .collect();
+    let stream = |k: usize| {
+        let mut s = sampler.stream([k as u32 % 40, k as u32 / 40], k as u32 % 16);
+        s.camera();
+        s
+    };
+    let mut dims: Vec<_> = (0..rays.len()).map(stream).collect();
+    let together = integrator.li_and_hit_batch(&scene.0, &scene.1, &rays, &mut dims);
+    let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+    for (k, r) in rays.iter().enumerate() {
+        let one = integrator.li_and_hit(&scene.0, &scene.1, r, &mut stream(k));
+        assert_eq!(
+            (bits(together[k].0), together[k].1),
+            (bits(one.0), one.1),
+            "ray {k}"
+        );
+        // Each path's stream stopped where the one-path loop's did.
+        let mut alone = stream(k);
+        integrator.li_and_hit(&scene.0, &scene.1, r, &mut alone);
+        assert_eq!(dims[k].dimension(), alone.dimension(), "ray {k}");
+    }
+    // Not vacuous: some rays escape to the map, most carry light.
+    let lit = together.iter().filter(|v| v.0.max_element() > 0.0).count();
+    let missed = together.iter().filter(|v| !v.1).count();
+    assert!(lit > 1500 && missed > 0, "{lit} lit, {missed} missed");
+}
