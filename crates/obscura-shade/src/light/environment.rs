@@ -236,7 +236,7 @@ fn atan2(y: f32, x: f32) -> f32 {
     let t2 = t * t;
     let mut p = P[9];
     for &c in P[..9].iter().rev() {
-        p = p.mul_add(t2, c);
+        p = p * t2 + c;
     }
     let mut a = t * p;
     if ay > ax {
