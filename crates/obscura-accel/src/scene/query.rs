@@ -4,6 +4,7 @@
 use super::{Analytic, Found, Item, PlainRay, Scene, Top, to_object};
 use crate::geom::intersect_sphere;
 use crate::hit::Hit;
+use crate::simd::prefetch;
 use crate::wide::{BatchRay, BoxSet, WideBvh};
 use glam::{Vec2, Vec3};
 use obscura_space::{Bounds3, Ray, World};
@@ -143,7 +144,39 @@ impl Scene {
     /// on each, but on a large mesh several rays are traversed in turns so that their cache
     /// misses overlap (faster per ray where the BVH does not fit the cache).
     pub fn intersect_batch(&self, rays: &[Ray<World>]) -> Vec<Option<Hit>> {
-        self.found_batch(rays)
+        let found = self.found_batch(rays);
+        // A mesh hit's record reads the triangle's vertex indices, then its vertices' normals,
+        // at random in arrays of megabytes: ask for the indices of every hit, then, once
+        // they have come, for the normals, so that the records' misses overlap.
+        // A mesh without normals (nor uvs asked for) reads neither.
+        let mesh_hits = || {
+            found.iter().filter_map(|f| match f {
+                Some((_, Found::Flat { hit })) => {
+                    let [primitive, instance] = hit.ids;
+                    let mesh = self.meshes.get(instance as usize)?.as_ref()?;
+                    if mesh.normals().is_none() && !(self.uv && mesh.uvs().is_some()) {
+                        return None;
+                    }
+                    Some((mesh, mesh.triangles().get(primitive as usize)?))
+                }
+                _ => None,
+            })
+        };
+        if self.batches() {
+            for (_, vertices) in mesh_hits() {
+                prefetch(vertices, 0);
+            }
+            for (mesh, vertices) in mesh_hits() {
+                if let Some(normals) = mesh.normals() {
+                    for &v in vertices {
+                        if let Some(n) = normals.get(v as usize) {
+                            prefetch(n, 0);
+                        }
+                    }
+                }
+            }
+        }
+        found
             .into_iter()
             .map(|f| f.map(|(r, found)| self.finish(&r, found)))
             .collect()
