@@ -5,8 +5,9 @@
 //! visit next and then works on other rays while they arrive; a plain load in its place
 //! would hold up the retirement of everything behind it until the line came, which is what
 //! the batch exists to avoid. The path tracer asks ahead in the same way for the environment
-//! map's cells a round of paths will read. A prefetch is a hint: it never faults and never changes what a
-//! later load returns, so the portable path (no instruction at all) gives the same results.
+//! map's cells a round of paths will read. A prefetch is a hint: it never faults and never
+//! changes what a later load returns, so the portable path (no instruction at all) gives the
+//! same results.
 #![allow(unsafe_code)]
 
 /// Asks for the cache line holding `*item` and the `extra_lines` lines after it, into every

@@ -506,8 +506,6 @@ impl PathIntegrator {
         (shadow, true)
     }
 
-    /// One light sample at `hit`, MIS-weighted against BSDF sampling: its value if nothing
-    /// blocks it, and the shadow ray that decides that; `None` for a sample worth nothing.
     /// Asks the cache for the environment map's cell that the path's coming vertex at `hit`
     /// will read first: the escaped ray's lookup, or the guide entry of the light sample's
     /// search (when the vertex will sample a light and the peeked numbers pick the map), whose
@@ -551,6 +549,8 @@ impl PathIntegrator {
         Some(start)
     }
 
+    /// One light sample at `hit`, MIS-weighted against BSDF sampling: its value if nothing
+    /// blocks it, and the shadow ray that decides that; `None` for a sample worth nothing.
     #[inline(always)]
     fn sample_light(
         &self,

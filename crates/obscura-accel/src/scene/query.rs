@@ -147,8 +147,8 @@ impl Scene {
         let found = self.found_batch(rays);
         // A mesh hit's record reads the triangle's vertex indices, then its vertices' normals,
         // at random in arrays of megabytes: ask for the indices of every hit, then, once
-        // they have come, for the normals, so that the records' misses overlap.
-        // A mesh without normals (nor uvs asked for) reads neither.
+        // they have come, for the normals, so that the records' misses overlap. A mesh
+        // without normals (nor uvs asked for) reads neither.
         let mesh_hits = || {
             found.iter().filter_map(|f| match f {
                 Some((_, Found::Flat { hit })) => {
