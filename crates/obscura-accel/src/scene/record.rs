@@ -188,10 +188,13 @@ impl Scene {
         world_from_object: &Transform<World, Object>,
     ) -> Hit {
         let b = [1.0 - tri.b1 - tri.b2, tri.b1, tri.b2];
-        let vertices = mesh.triangles()[primitive as usize];
+        // The vertex indices are read only for what needs them: on a mesh of megabytes the
+        // read is a cache miss, and a mesh without normals or uvs has no use for it.
+        let vertices = || mesh.triangles()[primitive as usize];
         let n_shading = mesh
             .normals()
             .and_then(|normals| {
+                let vertices = vertices();
                 let n_object: Vec3 = (0..3).map(|k| normals[vertices[k] as usize] * b[k]).sum();
                 let n = world_from_object
                     .normal(Normal3::from_glam(n_object))
@@ -204,7 +207,10 @@ impl Scene {
             Vec2::ZERO
         } else {
             mesh.uvs()
-                .map(|uvs| (0..3).map(|k| uvs[vertices[k] as usize] * b[k]).sum())
+                .map(|uvs| {
+                    let vertices = vertices();
+                    (0..3).map(|k| uvs[vertices[k] as usize] * b[k]).sum()
+                })
                 .unwrap_or(Vec2::new(tri.b1, tri.b2))
         };
         Hit {
