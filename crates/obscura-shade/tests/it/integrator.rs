@@ -6,7 +6,7 @@ use core::f32::consts::{FRAC_1_PI, PI};
 use glam::{Vec2, Vec3};
 use obscura_accel::{Placement, Scene, SceneBuilder, Shape};
 use obscura_shade::{
-    EnvironmentLight, Light, Material, PathIntegrator, ShadingScene, power_heuristic,
+    EnvironmentLight, Light, Material, PathIntegrator, SampleDims, ShadingScene, power_heuristic,
 };
 use obscura_space::{AnimatedTransform, Object, Point3, Ray, Transform, Vector3, World};
 use proptest::prelude::*;
@@ -654,6 +654,43 @@ fn rippled_floor(n: u32, material: Material) -> (Shape, Placement, Material, Vec
     )
 }
 
+/// `count` rays from around `(0, 3, 7)` in random directions leaning towards `-z` and `dip`
+/// downwards: most meet `every_material_and_light`'s objects, some miss them all.
+fn rays_towards_the_scene(count: usize, seed: u64, dip: f32) -> Vec<Ray<World>> {
+    let mut rng = Rng::new(seed);
+    (0..count)
+        .map(|_| {
+            let origin = Vec3::new(0.0, 3.0, 7.0) + rng.direction() * 0.5;
+            ray(origin, rng.direction() + Vec3::new(0.0, -dip, -1.0), 0.0)
+        })
+        .collect()
+}
+
+/// Traces `rays` together ([`PathIntegrator::li_and_hit_batch`]) and one by one, path `k`
+/// drawing from `dims(k)` both times, and asserts that every value is the same bit for bit.
+/// Returns the values and the generators each way, as the paths left them.
+fn together_equals_alone<D: SampleDims>(
+    integrator: &PathIntegrator,
+    scene: &(Scene, ShadingScene),
+    rays: &[Ray<World>],
+    dims: impl Fn(usize) -> D,
+) -> (Vec<(Vec3, bool)>, [Vec<D>; 2]) {
+    let mut batch: Vec<D> = (0..rays.len()).map(&dims).collect();
+    let together = integrator.li_and_hit_batch(&scene.0, &scene.1, rays, &mut batch);
+    assert_eq!(together.len(), rays.len());
+    let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+    let mut alone: Vec<D> = (0..rays.len()).map(&dims).collect();
+    for (k, r) in rays.iter().enumerate() {
+        let one = integrator.li_and_hit(&scene.0, &scene.1, r, &mut alone[k]);
+        assert_eq!(
+            (bits(together[k].0), together[k].1),
+            (bits(one.0), one.1),
+            "ray {k}"
+        );
+    }
+    (together, [batch, alone])
+}
+
 #[test]
 fn paths_traced_together_equal_paths_traced_one_by_one() {
     // The batch (wavefront) path tracer must give every camera ray the very value the one-path
@@ -670,25 +707,9 @@ fn paths_traced_together_equal_paths_traced_one_by_one() {
     ));
     assert!(scene.0.batches(), "the floor is large enough for batches");
     let integrator = PathIntegrator::new(12);
-    let mut rng = Rng::new(7);
-    let rays: Vec<Ray<World>> = (0..3000)
-        .map(|_| {
-            let origin = Vec3::new(0.0, 3.0, 7.0) + rng.direction() * 0.5;
-            ray(origin, rng.direction() + Vec3::new(0.0, -0.4, -1.0), 0.0)
-        })
-        .collect();
-    let mut dims: Vec<Rng> = (0..rays.len() as u64).map(|k| Rng::new(1000 + k)).collect();
-    let together = integrator.li_and_hit_batch(&scene.0, &scene.1, &rays, &mut dims);
-    assert_eq!(together.len(), rays.len());
-    let bits = |v: Vec3| v.to_array().map(f32::to_bits);
-    for (k, r) in rays.iter().enumerate() {
-        let one = integrator.li_and_hit(&scene.0, &scene.1, r, &mut Rng::new(1000 + k as u64));
-        assert_eq!(
-            (bits(together[k].0), together[k].1),
-            (bits(one.0), one.1),
-            "ray {k}"
-        );
-    }
+    let rays = rays_towards_the_scene(3000, 7, 0.4);
+    let (together, _) =
+        together_equals_alone(&integrator, &scene, &rays, |k| Rng::new(1000 + k as u64));
     // Not vacuous: some rays miss everything, most carry light.
     let lit = together.iter().filter(|v| v.0.max_element() > 0.0).count();
     let missed = together.iter().filter(|v| !v.1).count();
@@ -707,32 +728,16 @@ fn paths_traced_together_under_an_environment_map_equal_paths_traced_one_by_one(
     assert!(!scene.0.batches() && scene.1.has_environment_map());
     let sampler = obscura_sample::Sampler::new(obscura_sample::SamplerKind::Sobol, 16, 3).unwrap();
     let integrator = PathIntegrator::new(12);
-    let mut rng = Rng::new(8);
-    let rays: Vec<Ray<World>> = (0..2000)
-        .map(|_| {
-            let origin = Vec3::new(0.0, 3.0, 7.0) + rng.direction() * 0.5;
-            ray(origin, rng.direction() + Vec3::new(0.0, -0.2, -1.0), 0.0)
-        })
-        .collect();
+    let rays = rays_towards_the_scene(2000, 8, 0.2);
     let stream = |k: usize| {
         let mut s = sampler.stream([k as u32 % 40, k as u32 / 40], k as u32 % 16);
         s.camera();
         s
     };
-    let mut dims: Vec<_> = (0..rays.len()).map(stream).collect();
-    let together = integrator.li_and_hit_batch(&scene.0, &scene.1, &rays, &mut dims);
-    let bits = |v: Vec3| v.to_array().map(f32::to_bits);
-    for (k, r) in rays.iter().enumerate() {
-        let one = integrator.li_and_hit(&scene.0, &scene.1, r, &mut stream(k));
-        assert_eq!(
-            (bits(together[k].0), together[k].1),
-            (bits(one.0), one.1),
-            "ray {k}"
-        );
-        // Each path's stream stopped where the one-path loop's did.
-        let mut alone = stream(k);
-        integrator.li_and_hit(&scene.0, &scene.1, r, &mut alone);
-        assert_eq!(dims[k].dimension(), alone.dimension(), "ray {k}");
+    let (together, [batch, alone]) = together_equals_alone(&integrator, &scene, &rays, stream);
+    // Each path's stream stopped where the one-path loop's did.
+    for (k, (b, a)) in batch.iter().zip(&alone).enumerate() {
+        assert_eq!(b.dimension(), a.dimension(), "ray {k}");
     }
     // Not vacuous: some rays escape to the map, most carry light.
     let lit = together.iter().filter(|v| v.0.max_element() > 0.0).count();
