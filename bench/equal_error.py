@@ -188,9 +188,11 @@ def read_exr(path):
     return np.array(mi.Bitmap(str(path)), dtype=np.float64)[:, :, :3]
 
 
-def obscura_render(toml, spp, seed, threads):
-    binary = TARGET / "release" / "obscura"
-    out = toml.with_name(f"{toml.stem}-{spp}-{seed}.exr")
+def obscura_render(toml, spp, seed, threads, binary=None, out=None):
+    """Renders `toml` with `binary` (this checkout's release build by default) pinned to the
+    first `threads` cores; returns the image, the render time it prints and the wall time."""
+    binary = binary or TARGET / "release" / "obscura"
+    out = out or toml.with_name(f"{toml.stem}-{spp}-{seed}.exr")
     cores = ",".join(str(c) for c in range(threads))
     start = time.perf_counter()
     run = subprocess.run(

@@ -5,31 +5,18 @@
         [--sampler sobol] [--build old=/path/to/obscura --build new=target/release/obscura]
 
 For each scene of `bench/equal_error.py` and each build (default: `target/release/obscura`),
-renders the scene at `--spp` with seeds 100, 101, ... on `--threads` threads and prints the
-relative RMSE against that harness's converged Mitsuba reference (built and cached the first
-time, as the harness does), the standard error of the mean MSE as a relative figure of the
-RMSE, and the median render time. Builds are run seed by seed in turn, so a machine that slows
+renders the scene at `--spp` with seeds 100, 101, ... on `--threads` pinned cores (the
+harness's own render call) and prints the relative RMSE against that harness's converged
+Mitsuba reference (built and cached the first time, as the harness does), the standard error
+of the mean MSE as a relative figure of the RMSE, and the median render time. Builds are run seed by seed in turn, so a machine that slows
 down slows them alike. The scenes and the error measure are the harness's own (imported).
 """
 
 import argparse
-import re
 import statistics
-import subprocess
 from pathlib import Path
 
 import equal_error as harness
-
-
-def render(binary, toml, spp, seed, threads, out):
-    run = subprocess.run(
-        [str(binary), "render", str(toml), "-o", str(out), "--spp", str(spp), "--seed",
-         str(seed), "--threads", str(threads)],
-        check=True, capture_output=True, text=True,
-    )
-    found = re.search(r" in ([0-9.]+) s ", run.stdout)
-    assert found, run.stdout
-    return harness.read_exr(out), float(found.group(1))
 
 
 def main():
@@ -55,7 +42,8 @@ def main():
         for seed in range(100, 100 + args.seeds):
             for label, binary in builds:
                 out = Path(toml).with_name(f"{Path(toml).stem}-{label}-{seed}.exr")
-                image, seconds = render(binary, toml, args.spp, seed, args.threads, out)
+                image, seconds, _ = harness.obscura_render(
+                    Path(toml), args.spp, seed, args.threads, binary=binary, out=out)
                 mses[label].append(harness.rel_mse(image, ref, ref))
                 times[label].append(seconds)
         for label, _ in builds:
