@@ -468,8 +468,7 @@ impl<S: Deref<Target = [GridCell]>> Distribution2D<S> {
     /// The value of the grid cell holding `p` in `[0, 1)^2` (clamped).
     #[inline]
     pub fn value(&self, p: Vec2) -> Vec3 {
-        let row = self.row(p.y);
-        Vec3::from_array(row.cells[row.bin(p.x)].value)
+        Vec3::from_array(self.cell(p).value)
     }
 
     /// [`Distribution2D::pdf`] and [`Distribution2D::value`] at `p`, from one cell of the grid.

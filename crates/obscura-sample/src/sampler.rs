@@ -74,11 +74,11 @@ impl FromStr for SamplerKind {
 ///
 /// Every value is a pure function of (pixel, sample index, dimension, seed), so a render is
 /// the same for any number of threads and any tile order. The kind and the samples per pixel
-/// choose the function: a stratified or Sobol sample depends on the spp it belongs to. Dimensions 0-1 are the film offset
-/// inside the pixel, 2-3 the lens, 4 the time; shading takes 5 and up through
-/// [`SampleStream`]. Dimensions are generated in pairs `(2p, 2p + 1)`: the stratified and
-/// Sobol samplers stratify each pair jointly, and every pair is decorrelated from every
-/// other pair per pixel.
+/// choose the function: a stratified or Sobol sample depends on the spp it belongs to.
+/// Dimensions 0-1 are the film offset inside the pixel, 2-3 the lens, 4 the time; shading
+/// takes 5 and up through [`SampleStream`]. Dimensions are generated in pairs `(2p, 2p + 1)`:
+/// the stratified and Sobol samplers stratify each pair jointly, and every pair is
+/// decorrelated from every other pair per pixel.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Sampler {
     kind: SamplerKind,
