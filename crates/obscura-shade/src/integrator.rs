@@ -81,8 +81,6 @@ pub struct ShadingScene {
     instance_light: Vec<Option<u32>>,
     /// Indices in `lights` of the environment lights (seen by rays that escape).
     environment: Vec<u32>,
-    /// Whether an environment light is a map, whose lookups read memory at random.
-    environment_map: bool,
 }
 
 impl ShadingScene {
@@ -138,16 +136,12 @@ impl ShadingScene {
             .filter(|(_, l)| matches!(l, Light::Environment(_)))
             .map(|(i, _)| i as u32)
             .collect();
-        let environment_map = lights
-            .iter()
-            .any(|l| matches!(l, Light::Environment(env) if env.is_map()));
         Ok(ShadingScene {
             materials,
             instance_material,
             lights,
             instance_light,
             environment,
-            environment_map,
         })
     }
 
@@ -186,7 +180,15 @@ impl ShadingScene {
     /// Whether one of the lights is an environment map: a light sample or an escaped path
     /// then reads its large table at a random place.
     pub fn has_environment_map(&self) -> bool {
-        self.environment_map
+        self.environment
+            .iter()
+            .any(|&i| matches!(&self.lights[i as usize], Light::Environment(env) if env.is_map()))
+    }
+
+    /// Whether a vertex on `material` samples a light (next-event estimation): never on a
+    /// specular material, whose BSDF no light sample can meet, nor without lights.
+    fn samples_light_on(&self, material: &Material) -> bool {
+        !material.is_specular() && !self.lights.is_empty()
     }
 
     /// The probability with which next-event estimation picks any one light (uniform choice).
@@ -454,7 +456,7 @@ impl PathIntegrator {
 
         // Next-event estimation: one light, chosen uniformly.
         let mut shadow = None;
-        if !material.is_specular() && !shading.lights.is_empty() {
+        if shading.samples_light_on(material) {
             // With one light there is nothing to choose: the number is skipped, not drawn.
             let u_light = dims.next_1d_if(shading.lights.len() > 1);
             let u2_light = dims.next_2d();
@@ -526,11 +528,11 @@ impl PathIntegrator {
             }
             return None;
         };
-        // The vertex samples a light only below the depth limit, on a non-specular material.
+        // The vertex goes on to shading (and perhaps a light sample) only below the depth limit.
         let samples_light = path.depth < self.max_depth
             && shading
                 .material(hit.instance)
-                .is_some_and(|m| !m.is_specular());
+                .is_some_and(|m| shading.samples_light_on(m));
         if !samples_light {
             return None;
         }
