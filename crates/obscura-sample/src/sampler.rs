@@ -407,7 +407,8 @@ mod tests {
                 reader.skip_1d();
             }
             let expected = reader.next_2d();
-            proptest::prop_assert_eq!(two.to_array().map(f32::to_bits), expected.to_array().map(f32::to_bits));
+            let bits = |v: Vec2| v.to_array().map(f32::to_bits);
+            proptest::prop_assert_eq!(bits(two), bits(expected));
             let mut unpeeked = stream.clone();
             proptest::prop_assert_eq!(stream.next_2d(), unpeeked.next_2d());
         }

@@ -208,10 +208,11 @@ pub fn direction_to_uv(d_light: Vec3) -> Vec2 {
 }
 
 /// `atan2(y, x)` of finite `x`, `y` in `[-pi, pi]`, within a few ulp of the exact value, with
-/// libm's signs at zeros and NaN for a NaN input; inlined, where a call to libm's `atan2f` costs more than
-/// the rest of a map lookup. `atan(t)` for `t = min / max` in `[0, 1]` is `t P(t^2)`, `P` of
-/// degree 9 fitted to `atan` by least squares in relative error (at most 1.4 ulp on `[0, 1]`
-/// in `f32`); the octant's symmetries `pi/2 - a`, `pi - a` and the sign of `y` give the rest.
+/// libm's signs at zeros and NaN for a NaN input; inlined, where a call to libm's `atan2f`
+/// costs more than the rest of a map lookup. `atan(t)` for `t = min / max` in `[0, 1]` is
+/// `t P(t^2)`, `P` of degree 9 fitted to `atan` by least squares in relative error (at most
+/// 1.4 ulp on `[0, 1]` in `f32`); the octant's symmetries `pi/2 - a`, `pi - a` and the sign of
+/// `y` give the rest.
 #[inline]
 fn atan2(y: f32, x: f32) -> f32 {
     const P: [f32; 10] = [
