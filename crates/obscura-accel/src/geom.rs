@@ -107,9 +107,10 @@ pub(crate) struct QuadHit {
     pub v: f32,
 }
 
-/// The parallelogram `origin + s * edge_u + v * edge_v`, `s, v` in `[0, 1]`, with its plane's
-/// normal `edge_u x edge_v` and that normal's squared length computed once, for the many rays
-/// a scene's quad meets (the same arithmetic as computing them per ray, so the same hits).
+/// The parallelogram `origin + s * edge_u + v * edge_v`, `s, v` in `[0, 1]`, with what every
+/// ray's test reads of it computed once: its plane's normal `edge_u x edge_v` and the two
+/// vectors whose dot products with a point's offset `w` from `origin` in the plane give `s`
+/// and `v`.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Parallelogram {
     /// The corner at `s = v = 0`.
@@ -120,20 +121,24 @@ pub(crate) struct Parallelogram {
     pub edge_v: Vec3,
     /// `edge_u x edge_v` (not normalised).
     pub n: Vec3,
-    /// `|n|^2`.
-    nn: f32,
+    /// `(edge_v x n) / |n|^2`: `s = w . to_s`.
+    pub to_s: Vec3,
+    /// `(n x edge_u) / |n|^2`: `v = w . to_v`.
+    pub to_v: Vec3,
 }
 
 impl Parallelogram {
     /// The parallelogram at `origin` spanned by `edge_u` and `edge_v`.
     pub(crate) fn new(origin: Vec3, edge_u: Vec3, edge_v: Vec3) -> Parallelogram {
         let n = edge_u.cross(edge_v);
+        let nn = n.length_squared();
         Parallelogram {
             origin,
             edge_u,
             edge_v,
             n,
-            nn: n.length_squared(),
+            to_s: edge_v.cross(n) / nn,
+            to_v: n.cross(edge_u) / nn,
         }
     }
 
@@ -148,10 +153,10 @@ impl Parallelogram {
     ) -> Option<QuadHit> {
         let Parallelogram {
             origin,
-            edge_u,
-            edge_v,
             n,
-            nn,
+            to_s,
+            to_v,
+            ..
         } = *self;
         let denom = n.dot(direction);
         if denom == 0.0 || !denom.is_finite() {
@@ -161,10 +166,11 @@ impl Parallelogram {
         if !(t >= t_min && t <= t_max) {
             return None;
         }
-        // w = s eu + v ev, so w x ev = s n and eu x w = v n.
+        // w = s eu + v ev in the plane. w x ev = s n, so s = n . (w x ev) / |n|^2, and by the
+        // triple product's cyclic symmetry that is w . (ev x n) / |n|^2; likewise for v.
         let w = ray_origin + direction * t - origin;
-        let s = n.dot(w.cross(edge_v)) / nn;
-        let v = n.dot(edge_u.cross(w)) / nn;
+        let s = w.dot(to_s);
+        let v = w.dot(to_v);
         ((0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&v)).then_some(QuadHit { t, s, v })
     }
 }
