@@ -1,7 +1,7 @@
 //! Collecting shapes and building the scene: validation, flattening static meshes, one BVH per
 //! moving mesh, and the top level over everything.
 
-use super::{Analytic, Item, Placed, Scene, Top, Xform};
+use super::{Analytic, Item, Placed, QuadSet, Scene, Top, Xform};
 use crate::error::AccelError;
 use crate::geom::Parallelogram;
 use crate::mesh::TriangleMesh;
@@ -246,19 +246,34 @@ impl SceneBuilder {
                     edge_u,
                     edge_v,
                 } => {
+                    // A static quad is carried to world space once, as static triangles are:
+                    // its rays then need no transform and its hits no carrying back. An affine
+                    // map takes a parallelogram to one, with the same (s, v) at each point.
+                    let (quad, flip, xform) = match (&placement, xform) {
+                        (Placement::Static(t), Xform::Static(_)) => {
+                            let m = t.matrix();
+                            let quad = Parallelogram::new(
+                                m.transform_point3(origin),
+                                m.transform_vector3(edge_u),
+                                m.transform_vector3(edge_v),
+                            );
+                            (quad, t.swaps_handedness(), Xform::Identity)
+                        }
+                        (_, xform) => (Parallelogram::new(origin, edge_u, edge_v), false, xform),
+                    };
                     let b = Bounds3::from_points(
                         [
-                            origin,
-                            origin + edge_u,
-                            origin + edge_v,
-                            origin + edge_u + edge_v,
+                            quad.origin,
+                            quad.origin + quad.edge_u,
+                            quad.origin + quad.edge_v,
+                            quad.origin + quad.edge_u + quad.edge_v,
                         ]
                         .map(Point3::from_glam),
                     );
                     item_bounds.push(xform.bounds(b));
                     items.push(Item::Analytic {
                         instance,
-                        shape: Analytic::Quad(Parallelogram::new(origin, edge_u, edge_v)),
+                        shape: Analytic::Quad { quad, flip },
                         xform,
                     });
                 }
@@ -288,9 +303,11 @@ impl SceneBuilder {
         }
         let bounds = item_bounds.iter().fold(Bounds3::EMPTY, |a, b| a.union(*b));
 
-        // The top level: none for a single item (one mesh, the common benchmark), one SIMD
-        // test of up to eight boxes for a few, two for up to sixteen spheres and quads (a
-        // tree over them costs more: docs/performance.md), obvhs's tree for more.
+        // The top level: none for a single item (one mesh, the common benchmark); for spheres
+        // and quads with static quads among them, the quads' own tests four at a time and
+        // the others' boxes; one SIMD test of up to eight boxes for a few items, two for up
+        // to sixteen spheres and quads (a tree over them costs more: docs/performance.md),
+        // obvhs's tree for more.
         let aabbs = item_bounds
             .iter()
             .map(|b| {
@@ -305,6 +322,8 @@ impl SceneBuilder {
             .collect::<Vec<_>>();
         let tlas = if items.len() <= 1 {
             Top::One
+        } else if let Some(top) = quads_first(&items, &aabbs) {
+            top
         } else if let Some(set) = BoxSet::new(&aabbs) {
             let sorted = items.iter().any(|i| !matches!(i, Item::Analytic { .. }));
             Top::Few { set, sorted }
@@ -341,4 +360,38 @@ impl SceneBuilder {
             uv: !self.no_uv,
         })
     }
+}
+
+/// The top level that tests a scene's static quads (those carried to world space) four at a
+/// time, without boxes, and its other items through their boxes: for a scene of spheres and
+/// quads only, with at least one static quad, at most [`QuadSet::CAPACITY`] of them and at
+/// most eight other items. `None` for any other scene.
+fn quads_first(items: &[Item], aabbs: &[Aabb]) -> Option<Top> {
+    let mut quads = Vec::new();
+    let mut others = Vec::new();
+    for (index, item) in items.iter().enumerate() {
+        match item {
+            Item::Analytic {
+                shape: Analytic::Quad { quad, .. },
+                xform: Xform::Identity,
+                ..
+            } => quads.push((index, *quad)),
+            Item::Analytic { .. } => others.push(index),
+            Item::Flat | Item::MovingMesh { .. } => return None,
+        }
+    }
+    if quads.is_empty() {
+        return None;
+    }
+    let boxes = if others.is_empty() {
+        None
+    } else {
+        let boxes: Vec<Aabb> = others.iter().map(|&i| aabbs[i]).collect();
+        Some(BoxSet::new(&boxes)?)
+    };
+    Some(Top::Quads {
+        quads: QuadSet::new(&quads)?,
+        boxes,
+        others,
+    })
 }

@@ -3,6 +3,7 @@
 //! full [`Hit`](crate::Hit) from what a query found.
 
 mod builder;
+mod quads;
 mod query;
 mod record;
 
@@ -15,6 +16,7 @@ use crate::wide::{BoxSet, WideBvh, WideHit};
 use glam::{Mat4, Vec3, Vec3A};
 use obscura_space::{AnimatedTransform, Bounds3, Object, Ray, Transform, World};
 use obvhs::cwbvh::CwBvh;
+use quads::QuadSet;
 use std::sync::Arc;
 
 /// A built scene, ready for ray queries from any number of threads.
@@ -51,6 +53,14 @@ enum Top {
     /// Nine to sixteen spheres and quads (a Cornell box and its contents): two sets of boxes,
     /// items `0..8` and `8..`, visited in index order like `Few { sorted: false }`.
     Two([BoxSet; 2]),
+    /// Spheres and quads only, among them up to sixteen static quads (carried to world space)
+    /// and up to eight others: the static quads tested four at a time without their boxes,
+    /// then the others through their boxes in index order (`others[lane]` is the item).
+    Quads {
+        quads: QuadSet,
+        boxes: Option<BoxSet>,
+        others: Vec<usize>,
+    },
     /// obvhs's tree over the items, with its slot -> item map.
     Tree(CwBvh, Vec<u32>),
 }
@@ -104,11 +114,23 @@ impl Xform {
 
 #[derive(Debug, Clone, Copy)]
 enum Analytic {
-    Sphere { center: Vec3, radius: f32 },
-    Quad(Parallelogram),
+    Sphere {
+        center: Vec3,
+        radius: f32,
+    },
+    /// A parallelogram; a static one is carried to world space when the scene is built (see
+    /// the builder), and `flip` then says that its placement mirrored it: its world edges'
+    /// cross product points against the inverse transpose of its object normal.
+    Quad {
+        quad: Parallelogram,
+        flip: bool,
+    },
 }
 
+/// One entry of the top level. A scene has few, and every ray reads some, so the large
+/// variants are not boxed (a box would add a pointer chase to every item test).
 #[derive(Debug)]
+#[allow(clippy::large_enum_variant)]
 enum Item {
     /// The flattened static triangles.
     Flat,

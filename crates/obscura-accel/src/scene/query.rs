@@ -136,7 +136,9 @@ impl Scene {
     fn pausable_flat(&self) -> Option<&WideBvh> {
         match self.tlas {
             Top::One | Top::Few { sorted: true, .. } => self.flat.as_ref(),
-            Top::Few { sorted: false, .. } | Top::Two(_) | Top::Tree(..) => None,
+            Top::Few { sorted: false, .. } | Top::Two(_) | Top::Quads { .. } | Top::Tree(..) => {
+                None
+            }
         }
     }
 
@@ -363,38 +365,29 @@ impl Scene {
                 // Spheres and quads in index order: the sort (and the zeroed array it fills)
                 // costs more than the item tests it would spare (docs/performance.md). One
                 // entered beyond the best hit so far is still skipped.
-                let (t_near, mut mask) = set.test(r.o, r.d, r.t_min, r.t_max);
-                let mut best: Option<Found> = None;
-                let mut t_best = r.t_max;
-                while mask != 0 {
-                    let item = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
-                    if t_near[item & 7] > t_best {
-                        continue;
-                    }
-                    if let Some(f) = self.intersect_item(item, r, t_best) {
-                        t_best = f.t();
-                        best = Some(f);
-                    }
-                }
+                let (mut best, mut t_best) = (None, r.t_max);
+                self.closest_in_order(set, |lane| lane, r, &mut best, &mut t_best);
                 best
             }
             Top::Two(sets) => {
-                let mut best: Option<Found> = None;
-                let mut t_best = r.t_max;
+                let (mut best, mut t_best) = (None, r.t_max);
                 for (base, set) in [0, BoxSet::CAPACITY].into_iter().zip(sets) {
-                    let (t_near, mut mask) = set.test(r.o, r.d, r.t_min, t_best);
-                    while mask != 0 {
-                        let lane = mask.trailing_zeros() as usize;
-                        mask &= mask - 1;
-                        if t_near[lane] > t_best {
-                            continue;
-                        }
-                        if let Some(f) = self.intersect_item(base + lane, r, t_best) {
-                            t_best = f.t();
-                            best = Some(f);
-                        }
-                    }
+                    self.closest_in_order(set, |lane| base + lane, r, &mut best, &mut t_best);
+                }
+                best
+            }
+            Top::Quads {
+                quads,
+                boxes,
+                others,
+            } => {
+                let (mut best, mut t_best) = (None, r.t_max);
+                if let Some((item, quad)) = quads.closest(r.o, r.d, r.t_min, r.t_max) {
+                    t_best = quad.t;
+                    best = Some(Found::Quad { item, quad });
+                }
+                if let Some(set) = boxes {
+                    self.closest_in_order(set, |lane| others[lane], r, &mut best, &mut t_best);
                 }
                 best
             }
@@ -425,32 +418,22 @@ impl Scene {
         match &self.tlas {
             Top::One if self.items.len() == 1 => self.occluded_item(0, &r),
             Top::One => false,
-            Top::Few { set, .. } => {
-                // Any order will do for a shadow ray.
-                let mut mask = set.entered_mask(r.o, r.d, r.t_min, r.t_max);
-                while mask != 0 {
-                    let item = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
-                    if self.occluded_item(item, &r) {
-                        return true;
-                    }
-                }
-                false
-            }
+            // Any order will do for a shadow ray.
+            Top::Few { set, .. } => self.any_in(set, |lane| lane, &r),
             Top::Two(sets) => [0, BoxSet::CAPACITY]
                 .into_iter()
                 .zip(sets)
-                .any(|(base, set)| {
-                    let mut mask = set.entered_mask(r.o, r.d, r.t_min, r.t_max);
-                    while mask != 0 {
-                        let lane = mask.trailing_zeros() as usize;
-                        mask &= mask - 1;
-                        if self.occluded_item(base + lane, &r) {
-                            return true;
-                        }
-                    }
-                    false
-                }),
+                .any(|(base, set)| self.any_in(set, |lane| base + lane, &r)),
+            Top::Quads {
+                quads,
+                boxes,
+                others,
+            } => {
+                quads.any(r.o, r.d, r.t_min, r.t_max)
+                    || boxes
+                        .as_ref()
+                        .is_some_and(|set| self.any_in(set, |lane| others[lane], &r))
+            }
             Top::Tree(tlas, order) => {
                 let top = obvhs::ray::Ray::new(r.o, r.d, r.t_min, r.t_max);
                 !tlas.ray_traverse_miss(top, |_, slot| {
@@ -488,6 +471,48 @@ impl Scene {
         flat + self.blases.iter().map(WideBvh::heap_bytes).sum::<usize>()
     }
 
+    /// Tests the items whose boxes in `set` the ray enters (lane `k`'s item is `item_of(k)`)
+    /// in lane order, each with the best distance so far as its `t_max`, and keeps the
+    /// closest hit in `best` and its distance in `t_best`. An item whose box is entered
+    /// beyond the best hit so far is skipped.
+    #[inline(always)]
+    fn closest_in_order(
+        &self,
+        set: &BoxSet,
+        item_of: impl Fn(usize) -> usize,
+        r: &PlainRay,
+        best: &mut Option<Found>,
+        t_best: &mut f32,
+    ) {
+        let (t_near, mut mask) = set.test(r.o, r.d, r.t_min, *t_best);
+        while mask != 0 {
+            let lane = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            if t_near[lane] > *t_best {
+                continue;
+            }
+            if let Some(f) = self.intersect_item(item_of(lane), r, *t_best) {
+                *t_best = f.t();
+                *best = Some(f);
+            }
+        }
+    }
+
+    /// Whether the ray hits an item whose box in `set` it enters (lane `k`'s item is
+    /// `item_of(k)`).
+    #[inline(always)]
+    fn any_in(&self, set: &BoxSet, item_of: impl Fn(usize) -> usize, r: &PlainRay) -> bool {
+        let mut mask = set.entered_mask(r.o, r.d, r.t_min, r.t_max);
+        while mask != 0 {
+            let lane = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            if self.occluded_item(item_of(lane), r) {
+                return true;
+            }
+        }
+        false
+    }
+
     /// The closest hit on one item with `t` in `[r.t_min, t_max]`.
     #[inline]
     fn intersect_item(&self, item: usize, r: &PlainRay, t_max: f32) -> Option<Found> {
@@ -513,8 +538,8 @@ impl Scene {
                         let t = intersect_sphere(o, d, r.t_min, t_max, center, radius)?;
                         Some(Found::Sphere { item, t })
                     }
-                    Analytic::Quad(parallelogram) => {
-                        let quad = parallelogram.intersect(o, d, r.t_min, t_max)?;
+                    Analytic::Quad { quad, .. } => {
+                        let quad = quad.intersect(o, d, r.t_min, t_max)?;
                         Some(Found::Quad { item, quad })
                     }
                 }
