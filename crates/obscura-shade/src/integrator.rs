@@ -316,6 +316,7 @@ impl PathIntegrator {
         let mut shadow_rays = Vec::new();
         let mut going_on = Vec::with_capacity(live.len());
         let mut searches = Vec::new();
+        let mut sky_uvs = Vec::new();
         while !live.is_empty() {
             next_rays.clear();
             next_rays.extend(live.iter().map(|(_, path)| path.ray));
@@ -323,14 +324,22 @@ impl PathIntegrator {
             if shading.has_environment_map() {
                 // Ask for the map's cells in two sweeps: the lines each vertex reads first,
                 // then, once the guide entries have come, the cells the searches compare.
+                // An escaped path's map coordinates are kept for its vertex's lookup.
                 searches.clear();
+                sky_uvs.clear();
                 for ((slot, path), hit) in live.iter().zip(&hits) {
-                    searches.extend(self.prefetch_vertex(
-                        shading,
-                        path,
-                        hit.as_ref(),
-                        &mut dims[*slot],
-                    ));
+                    match hit {
+                        None => sky_uvs.push(prefetch_escaped(shading, path)),
+                        Some(hit) => {
+                            sky_uvs.push(None);
+                            searches.extend(self.prefetch_light_sample(
+                                shading,
+                                path,
+                                hit,
+                                &mut dims[*slot],
+                            ));
+                        }
+                    }
                 }
                 for search in &searches {
                     obscura_accel::prefetch(search.searched_cell(), 0);
@@ -338,7 +347,8 @@ impl PathIntegrator {
             }
             going_on.clear();
             for (k, ((slot, path), hit)) in live.iter_mut().zip(hits).enumerate() {
-                let (shadow, more) = self.vertex(shading, path, hit, &mut dims[*slot]);
+                let sky_uv = sky_uvs.get(k).copied().flatten();
+                let (shadow, more) = self.vertex(shading, path, hit, sky_uv, &mut dims[*slot]);
                 if let Some(shadow) = shadow {
                     pending.push((k, shadow));
                 }
@@ -376,7 +386,7 @@ impl PathIntegrator {
         };
         loop {
             let hit = geometry.intersect(&path.ray);
-            let (shadow, more) = self.vertex(shading, &mut path, hit, dims);
+            let (shadow, more) = self.vertex(shading, &mut path, hit, None, dims);
             if let Some(shadow) = shadow {
                 let blocked = geometry.occluded(&shadow.ray);
                 path.add_light(shadow, blocked);
@@ -390,12 +400,14 @@ impl PathIntegrator {
     /// One vertex of `path`, where its ray met `hit` (or escaped): emission, the light
     /// sample, and the next ray by sampling the BSDF. The light sample's shadow ray is left
     /// to the caller ([`PathState::add_light`] once it is answered). False when the path ends.
+    /// `sky_uv`: for an escaped ray, the map coordinates [`prefetch_escaped`] found, if any.
     #[inline(always)]
     fn vertex(
         &self,
         shading: &ShadingScene,
         path: &mut PathState,
         hit: Option<Hit>,
+        sky_uv: Option<Vec2>,
         dims: &mut impl SampleDims,
     ) -> (Option<Shadow>, bool) {
         let light_select = shading.light_select_pdf();
@@ -407,9 +419,9 @@ impl PathIntegrator {
                     continue;
                 };
                 let (le, weight) = if path.specular_bounce {
-                    (env.radiance(d_world), 1.0)
+                    (env.radiance_at(d_world, sky_uv), 1.0)
                 } else {
-                    let (le, pdf) = env.radiance_and_pdf(d_world);
+                    let (le, pdf) = env.radiance_and_pdf_at(d_world, sky_uv);
                     (le, power_heuristic(path.prev_pdf, light_select * pdf))
                 };
                 path.radiance += path.beta * le * weight;
@@ -508,26 +520,18 @@ impl PathIntegrator {
         (shadow, true)
     }
 
-    /// Asks the cache for the environment map's cell that the path's coming vertex at `hit`
-    /// will read first: the escaped ray's lookup, or the guide entry of the light sample's
-    /// search (when the vertex will sample a light and the peeked numbers pick the map), whose
-    /// start it returns. Draws no number and changes no result.
+    /// Asks the cache for the guide entry of the light sample the path's coming vertex at
+    /// `hit` will search the environment map with (when the vertex will sample a light and
+    /// the peeked numbers pick the map), and returns the search's start. Draws no number and
+    /// changes no result.
     #[inline]
-    fn prefetch_vertex<'s>(
+    fn prefetch_light_sample<'s>(
         &self,
         shading: &'s ShadingScene,
         path: &PathState,
-        hit: Option<&Hit>,
+        hit: &Hit,
         dims: &mut impl SampleDims,
     ) -> Option<SearchStart<'s>> {
-        let Some(hit) = hit else {
-            for &i in &shading.environment {
-                if let Light::Environment(env) = &shading.lights[i as usize] {
-                    env.prefetch_lookup(path.ray.direction.to_glam());
-                }
-            }
-            return None;
-        };
         // The vertex goes on to shading (and perhaps a light sample) only below the depth limit.
         let samples_light = path.depth < self.max_depth
             && shading
@@ -590,6 +594,25 @@ impl PathIntegrator {
             f * ls.radiance * weight / pdf_light
         };
         Some((value, shadow))
+    }
+}
+
+/// Asks the cache for the environment map's cell an escaped path's vertex will read, and
+/// returns its map coordinates for that vertex (`EnvironmentLight::radiance_and_pdf_at`):
+/// only for a scene with one environment light, the one whose coordinates they are.
+#[inline]
+fn prefetch_escaped(shading: &ShadingScene, path: &PathState) -> Option<Vec2> {
+    let &[i] = shading.environment.as_slice() else {
+        for &i in &shading.environment {
+            if let Light::Environment(env) = &shading.lights[i as usize] {
+                env.prefetch_lookup(path.ray.direction.to_glam());
+            }
+        }
+        return None;
+    };
+    match &shading.lights[i as usize] {
+        Light::Environment(env) => env.prefetch_lookup(path.ray.direction.to_glam()),
+        _ => None,
     }
 }
 

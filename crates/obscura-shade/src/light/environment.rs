@@ -104,10 +104,18 @@ impl EnvironmentLight {
 
     /// The radiance arriving from world direction `d_world` (unit), i.e. seen looking along it.
     pub fn radiance(&self, d_world: Vec3) -> Vec3 {
+        self.radiance_at(d_world, None)
+    }
+
+    /// [`EnvironmentLight::radiance`], given the map coordinates of `d_world` when the caller
+    /// has them: `uv` must be what [`EnvironmentLight::prefetch_lookup`] returned for the same
+    /// direction (`None`: found here).
+    #[inline]
+    pub fn radiance_at(&self, d_world: Vec3, uv: Option<Vec2>) -> Vec3 {
         match &self.kind {
             EnvironmentKind::Constant(l) => *l,
             EnvironmentKind::Map(map) => {
-                let uv = direction_to_uv(map.light_from_world * d_world);
+                let uv = uv.unwrap_or_else(|| direction_to_uv(map.light_from_world * d_world));
                 map.distribution.value(uv)
             }
         }
@@ -156,14 +164,18 @@ impl EnvironmentLight {
         }
     }
 
-    /// Asks the cache for the line [`EnvironmentLight::radiance_and_pdf`] reads for `d_world`.
-    /// Changes nothing else.
+    /// Asks the cache for the line [`EnvironmentLight::radiance_and_pdf`] reads for `d_world`,
+    /// and returns the map coordinates it found there (`None` for a constant), for
+    /// [`EnvironmentLight::radiance_at`] and [`EnvironmentLight::radiance_and_pdf_at`] to take
+    /// instead of finding them again. Changes nothing else.
     #[inline]
-    pub fn prefetch_lookup(&self, d_world: Vec3) {
-        if let EnvironmentKind::Map(map) = &self.kind {
-            let uv = direction_to_uv(map.light_from_world * d_world);
-            obscura_accel::prefetch(map.distribution.cell(uv), 0);
-        }
+    pub fn prefetch_lookup(&self, d_world: Vec3) -> Option<Vec2> {
+        let EnvironmentKind::Map(map) = &self.kind else {
+            return None;
+        };
+        let uv = direction_to_uv(map.light_from_world * d_world);
+        obscura_accel::prefetch(map.distribution.cell(uv), 0);
+        Some(uv)
     }
 
     /// The solid-angle density with which [`EnvironmentLight::sample_li`] returns `d_world`.
@@ -174,11 +186,19 @@ impl EnvironmentLight {
     /// [`EnvironmentLight::radiance`] and [`EnvironmentLight::pdf_li`] of one direction, with
     /// the direction's map coordinates found once (what a path that escapes needs).
     pub fn radiance_and_pdf(&self, d_world: Vec3) -> (Vec3, f32) {
+        self.radiance_and_pdf_at(d_world, None)
+    }
+
+    /// [`EnvironmentLight::radiance_and_pdf`], given the map coordinates of `d_world` when the
+    /// caller has them: `uv` must be what [`EnvironmentLight::prefetch_lookup`] returned for
+    /// the same direction (`None`: found here).
+    #[inline]
+    pub fn radiance_and_pdf_at(&self, d_world: Vec3, uv: Option<Vec2>) -> (Vec3, f32) {
         match &self.kind {
             EnvironmentKind::Constant(l) => (*l, uniform_sphere_pdf()),
             EnvironmentKind::Map(map) => {
                 let d_light = map.light_from_world * d_world;
-                let uv = direction_to_uv(d_light);
+                let uv = uv.unwrap_or_else(|| direction_to_uv(d_light));
                 // sin(theta) from the direction itself: well conditioned at the poles, where
                 // going through acos would lose most digits.
                 let sin_theta = Vec2::new(d_light.x, d_light.z).length() / d_light.length();
