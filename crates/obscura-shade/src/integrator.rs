@@ -616,14 +616,14 @@ fn prefetch_escaped(shading: &ShadingScene, path: &PathState) -> Option<Vec2> {
     }
 }
 
-/// A path under way: its next ray, throughput and radiance so far, and what MIS needs of the
-/// previous scattering.
 /// The light that number `u` in `[0, 1)` picks among `count` (at least one), uniformly.
 #[inline(always)]
 fn light_index(u: f32, count: usize) -> usize {
     ((u * count as f32) as usize).min(count - 1)
 }
 
+/// A path under way: its next ray, throughput and radiance so far, and what MIS needs of the
+/// previous scattering.
 #[derive(Clone, Copy, Debug)]
 struct PathState {
     ray: Ray<World>,
