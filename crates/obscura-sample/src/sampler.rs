@@ -311,10 +311,23 @@ impl SampleStream<'_> {
     /// The next aligned pair of dimensions, in `[0, 1)^2`.
     #[inline]
     pub fn next_2d(&mut self) -> Vec2 {
-        let first = self.dimension.saturating_add(self.dimension % 2);
+        let first = self.next_pair_start();
         let u2 = self.pair(first);
         self.dimension = first.saturating_add(2);
         u2
+    }
+
+    /// Moves past the pair [`SampleStream::next_2d`] would return without computing it (for a
+    /// caller that peeked it): the dimensions after are the same as after `next_2d`.
+    #[inline]
+    pub fn skip_2d(&mut self) {
+        self.dimension = self.next_pair_start().saturating_add(2);
+    }
+
+    /// The first dimension of the next aligned pair.
+    #[inline]
+    fn next_pair_start(&self) -> u32 {
+        self.dimension.saturating_add(self.dimension % 2)
     }
 
     /// The dimension the next [`SampleStream::next_1d`] will read.
@@ -411,6 +424,12 @@ mod tests {
             proptest::prop_assert_eq!(bits(two), bits(expected));
             let mut unpeeked = stream.clone();
             proptest::prop_assert_eq!(stream.next_2d(), unpeeked.next_2d());
+            // Skipping a pair leaves the stream where drawing it does.
+            let (mut skipped, mut drawn) = (stream.clone(), stream.clone());
+            skipped.skip_2d();
+            drawn.next_2d();
+            proptest::prop_assert_eq!(skipped.dimension(), drawn.dimension());
+            proptest::prop_assert_eq!(skipped.next_1d().to_bits(), drawn.next_1d().to_bits());
         }
     }
 

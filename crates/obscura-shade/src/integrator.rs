@@ -34,6 +34,11 @@ pub trait SampleDims {
     fn skip_1d(&mut self) {
         self.next_1d();
     }
+    /// Moves past the next pair (one the caller peeked): the numbers after it must be the
+    /// same as after [`SampleDims::next_2d`]. The default draws it and drops it.
+    fn skip_2d(&mut self) {
+        self.next_2d();
+    }
     /// The next number if `read`; otherwise skips it and returns 0.5, for a choice that has
     /// one outcome (the dimensions after are the same either way).
     #[inline]
@@ -59,6 +64,10 @@ impl SampleDims for SampleStream<'_> {
     #[inline]
     fn skip_1d(&mut self) {
         SampleStream::skip_1d(self)
+    }
+    #[inline]
+    fn skip_2d(&mut self) {
+        SampleStream::skip_2d(self)
     }
     #[inline]
     fn peek_1d(&mut self) -> Option<f32> {
@@ -316,7 +325,7 @@ impl PathIntegrator {
         let mut shadow_rays = Vec::new();
         let mut going_on = Vec::with_capacity(live.len());
         let mut searches = Vec::new();
-        let mut sky_uvs = Vec::new();
+        let mut ahead = Vec::new();
         while !live.is_empty() {
             next_rays.clear();
             next_rays.extend(live.iter().map(|(_, path)| path.ray));
@@ -324,22 +333,26 @@ impl PathIntegrator {
             if shading.has_environment_map() {
                 // Ask for the map's cells in two sweeps: the lines each vertex reads first,
                 // then, once the guide entries have come, the cells the searches compare.
-                // An escaped path's map coordinates are kept for its vertex's lookup.
+                // What the sweep found on the way (an escaped path's map coordinates, a light
+                // sample's peeked numbers) is kept for the vertex, which need not find it again.
                 searches.clear();
-                sky_uvs.clear();
+                ahead.clear();
                 for ((slot, path), hit) in live.iter().zip(&hits) {
-                    match hit {
-                        None => sky_uvs.push(prefetch_escaped(shading, path)),
+                    ahead.push(match hit {
+                        None => Ahead {
+                            sky_uv: prefetch_escaped(shading, path),
+                            light_numbers: None,
+                        },
                         Some(hit) => {
-                            sky_uvs.push(None);
-                            searches.extend(self.prefetch_light_sample(
-                                shading,
-                                path,
-                                hit,
-                                &mut dims[*slot],
-                            ));
+                            let found =
+                                self.prefetch_light_sample(shading, path, hit, &mut dims[*slot]);
+                            searches.extend(found.map(|(start, _)| start));
+                            Ahead {
+                                sky_uv: None,
+                                light_numbers: found.map(|(_, numbers)| numbers),
+                            }
                         }
-                    }
+                    });
                 }
                 for search in &searches {
                     obscura_accel::prefetch(search.searched_cell(), 0);
@@ -347,8 +360,8 @@ impl PathIntegrator {
             }
             going_on.clear();
             for (k, ((slot, path), hit)) in live.iter_mut().zip(hits).enumerate() {
-                let sky_uv = sky_uvs.get(k).copied().flatten();
-                let (shadow, more) = self.vertex(shading, path, hit, sky_uv, &mut dims[*slot]);
+                let found = ahead.get(k).copied().unwrap_or_default();
+                let (shadow, more) = self.vertex(shading, path, hit, found, &mut dims[*slot]);
                 if let Some(shadow) = shadow {
                     pending.push((k, shadow));
                 }
@@ -386,7 +399,7 @@ impl PathIntegrator {
         };
         loop {
             let hit = geometry.intersect(&path.ray);
-            let (shadow, more) = self.vertex(shading, &mut path, hit, None, dims);
+            let (shadow, more) = self.vertex(shading, &mut path, hit, Ahead::default(), dims);
             if let Some(shadow) = shadow {
                 let blocked = geometry.occluded(&shadow.ray);
                 path.add_light(shadow, blocked);
@@ -400,14 +413,14 @@ impl PathIntegrator {
     /// One vertex of `path`, where its ray met `hit` (or escaped): emission, the light
     /// sample, and the next ray by sampling the BSDF. The light sample's shadow ray is left
     /// to the caller ([`PathState::add_light`] once it is answered). False when the path ends.
-    /// `sky_uv`: for an escaped ray, the map coordinates [`prefetch_escaped`] found, if any.
+    /// `ahead`: what a round's prefetch sweep found for this vertex, if it ran.
     #[inline(always)]
     fn vertex(
         &self,
         shading: &ShadingScene,
         path: &mut PathState,
         hit: Option<Hit>,
-        sky_uv: Option<Vec2>,
+        ahead: Ahead,
         dims: &mut impl SampleDims,
     ) -> (Option<Shadow>, bool) {
         let light_select = shading.light_select_pdf();
@@ -419,9 +432,9 @@ impl PathIntegrator {
                     continue;
                 };
                 let (le, weight) = if path.specular_bounce {
-                    (env.radiance_at(d_world, sky_uv), 1.0)
+                    (env.radiance_at(d_world, ahead.sky_uv), 1.0)
                 } else {
-                    let (le, pdf) = env.radiance_and_pdf_at(d_world, sky_uv);
+                    let (le, pdf) = env.radiance_and_pdf_at(d_world, ahead.sky_uv);
                     (le, power_heuristic(path.prev_pdf, light_select * pdf))
                 };
                 path.radiance += path.beta * le * weight;
@@ -470,8 +483,21 @@ impl PathIntegrator {
         let mut shadow = None;
         if shading.samples_light_on(material) {
             // With one light there is nothing to choose: the number is skipped, not drawn.
-            let u_light = dims.next_1d_if(shading.lights.len() > 1);
-            let u2_light = dims.next_2d();
+            // Numbers the sweep peeked are moved past, not computed again.
+            let several = shading.lights.len() > 1;
+            let (u_light, u2_light) = match ahead.light_numbers {
+                Some((u_light, u2)) => {
+                    let u_light = if several {
+                        dims.skip_1d();
+                        u_light
+                    } else {
+                        dims.next_1d_if(false)
+                    };
+                    dims.skip_2d();
+                    (u_light, u2)
+                }
+                None => (dims.next_1d_if(several), dims.next_2d()),
+            };
             match self.sample_light(shading, &hit, material, &frame, wo, u_light, u2_light) {
                 Some((value, ray)) => {
                     shadow = Some(Shadow {
@@ -522,7 +548,8 @@ impl PathIntegrator {
 
     /// Asks the cache for the guide entry of the light sample the path's coming vertex at
     /// `hit` will search the environment map with (when the vertex will sample a light and
-    /// the peeked numbers pick the map), and returns the search's start. Draws no number and
+    /// the peeked numbers pick the map), and returns the search's start and the numbers it
+    /// peeked: the light's choice (unused with one light) and the pair. Draws no number and
     /// changes no result.
     #[inline]
     fn prefetch_light_sample<'s>(
@@ -531,7 +558,7 @@ impl PathIntegrator {
         path: &PathState,
         hit: &Hit,
         dims: &mut impl SampleDims,
-    ) -> Option<SearchStart<'s>> {
+    ) -> Option<(SearchStart<'s>, (f32, Vec2))> {
         // The vertex goes on to shading (and perhaps a light sample) only below the depth limit.
         let samples_light = path.depth < self.max_depth
             && shading
@@ -542,17 +569,14 @@ impl PathIntegrator {
         }
         // Its numbers: the light's choice (drawn only among several), then the pair.
         let count = shading.lights.len();
-        let index = if count > 1 {
-            light_index(dims.peek_1d()?, count)
-        } else {
-            0
-        };
-        let Some(Light::Environment(env)) = shading.lights.get(index) else {
+        let u_light = if count > 1 { dims.peek_1d()? } else { 0.0 };
+        let Some(Light::Environment(env)) = shading.lights.get(light_index(u_light, count)) else {
             return None;
         };
-        let start = env.sample_start(dims.peek_2d(1)?)?;
+        let u2 = dims.peek_2d(1)?;
+        let start = env.sample_start(u2)?;
         obscura_accel::prefetch(start.guide_cell(), 0);
-        Some(start)
+        Some((start, (u_light, u2)))
     }
 
     /// One light sample at `hit`, MIS-weighted against BSDF sampling: its value if nothing
@@ -595,6 +619,17 @@ impl PathIntegrator {
         };
         Some((value, shadow))
     }
+}
+
+/// What a round's prefetch sweep found for a path's coming vertex, which the vertex then
+/// need not find again.
+#[derive(Clone, Copy, Debug, Default)]
+struct Ahead {
+    /// An escaped ray's map coordinates ([`prefetch_escaped`]).
+    sky_uv: Option<Vec2>,
+    /// The light sample's numbers, peeked: the light's choice (unused with one light) and the
+    /// pair.
+    light_numbers: Option<(f32, Vec2)>,
 }
 
 /// Asks the cache for the environment map's cell an escaped path's vertex will read, and
