@@ -322,25 +322,25 @@ def run(scenes, spps, threads, seeds_per_spp=2):
         print(f"  {'configuration':<26}{'spp':>6}{'time s':>9}{'rel RMSE':>10}{'efficiency':>12}")
         scene_result = {"scene": name, "machine": machine, "reference_rel_mse": ref_mse,
                         "configs": []}
-        for label, sampler in OBSCURA_CONFIGS:
-            toml = obscura_scene(xml, sampler)
-            points = []
-            for spp in spps:
+        # One spp at a time, every configuration at it: the host's speed drifts over the
+        # minutes a scene takes, and this way the drift falls on every configuration alike,
+        # not on whichever ran last.
+        tomls = {label: obscura_scene(xml, sampler) for label, sampler in OBSCURA_CONFIGS}
+        points = {label: [] for label in [*tomls, *(label for label, _, _ in configs)]}
+        for spp in spps:
+            for label, toml in tomls.items():
                 for seed in range(seeds_per_spp):
                     image, render_s, wall_s = obscura_render(toml, spp, seed, threads)
-                    points.append({"spp": spp, "seed": seed, "time_s": render_s,
-                                   "wall_s": wall_s, "rel_mse": rel_mse(image, ref, ref)})
-            scene_result["configs"].append({"label": label, "points": points})
-        for label, variant, params in configs:
-            points = []
-            for spp in spps:
+                    points[label].append({"spp": spp, "seed": seed, "time_s": render_s,
+                                          "wall_s": wall_s, "rel_mse": rel_mse(image, ref, ref)})
+            for label, variant, params in configs:
                 seeds = list(range(seeds_per_spp))
                 images, info = mitsuba_render(variant, xml, spp, seeds, params, threads)
                 for seed, image, t in zip(seeds, images, info["times"]):
-                    points.append({"spp": spp, "seed": seed, "time_s": t,
-                                   "load_s": info["load_s"], "first_s": info["first_s"],
-                                   "rel_mse": rel_mse(image, ref, ref)})
-            scene_result["configs"].append({"label": label, "points": points})
+                    points[label].append({"spp": spp, "seed": seed, "time_s": t,
+                                          "load_s": info["load_s"], "first_s": info["first_s"],
+                                          "rel_mse": rel_mse(image, ref, ref)})
+        scene_result["configs"] = [{"label": label, "points": pts} for label, pts in points.items()]
         for config in scene_result["configs"]:
             for spp in spps:
                 pts = [p for p in config["points"] if p["spp"] == spp]
