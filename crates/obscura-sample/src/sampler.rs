@@ -304,14 +304,13 @@ impl SampleStream<'_> {
     /// [`SampleStream::skip_1d`], without moving the cursor.
     #[inline]
     pub fn peek_2d(&self, skip: u32) -> Vec2 {
-        let first = self.dimension.saturating_add(skip);
-        self.pair(first.saturating_add(first % 2))
+        self.pair(pair_start(self.dimension.saturating_add(skip)))
     }
 
     /// The next aligned pair of dimensions, in `[0, 1)^2`.
     #[inline]
     pub fn next_2d(&mut self) -> Vec2 {
-        let first = self.next_pair_start();
+        let first = pair_start(self.dimension);
         let u2 = self.pair(first);
         self.dimension = first.saturating_add(2);
         u2
@@ -321,13 +320,7 @@ impl SampleStream<'_> {
     /// caller that peeked it): the dimensions after are the same as after `next_2d`.
     #[inline]
     pub fn skip_2d(&mut self) {
-        self.dimension = self.next_pair_start().saturating_add(2);
-    }
-
-    /// The first dimension of the next aligned pair.
-    #[inline]
-    fn next_pair_start(&self) -> u32 {
-        self.dimension.saturating_add(self.dimension % 2)
+        self.dimension = pair_start(self.dimension).saturating_add(2);
     }
 
     /// The dimension the next [`SampleStream::next_1d`] will read.
@@ -339,6 +332,13 @@ impl SampleStream<'_> {
     pub fn index(&self) -> u32 {
         self.index
     }
+}
+
+/// The first dimension of the aligned pair a 2D read at cursor `dimension` takes: `dimension`
+/// itself when even, the next one when odd.
+#[inline]
+fn pair_start(dimension: u32) -> u32 {
+    dimension.saturating_add(dimension % 2)
 }
 
 #[cfg(test)]

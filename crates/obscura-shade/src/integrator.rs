@@ -483,20 +483,15 @@ impl PathIntegrator {
         let mut shadow = None;
         if shading.samples_light_on(material) {
             // With one light there is nothing to choose: the number is skipped, not drawn.
-            // Numbers the sweep peeked are moved past, not computed again.
-            let several = shading.lights.len() > 1;
+            // Numbers the sweep peeked are moved past, not computed again (with one light its
+            // choice is any number: every number picks light 0).
             let (u_light, u2_light) = match ahead.light_numbers {
-                Some((u_light, u2)) => {
-                    let u_light = if several {
-                        dims.skip_1d();
-                        u_light
-                    } else {
-                        dims.next_1d_if(false)
-                    };
+                Some(numbers) => {
+                    dims.skip_1d();
                     dims.skip_2d();
-                    (u_light, u2)
+                    numbers
                 }
-                None => (dims.next_1d_if(several), dims.next_2d()),
+                None => (dims.next_1d_if(shading.lights.len() > 1), dims.next_2d()),
             };
             match self.sample_light(shading, &hit, material, &frame, wo, u_light, u2_light) {
                 Some((value, ray)) => {
@@ -549,8 +544,8 @@ impl PathIntegrator {
     /// Asks the cache for the guide entry of the light sample the path's coming vertex at
     /// `hit` will search the environment map with (when the vertex will sample a light and
     /// the peeked numbers pick the map), and returns the search's start and the numbers it
-    /// peeked: the light's choice (unused with one light) and the pair. Draws no number and
-    /// changes no result.
+    /// peeked: the light's choice (0 with one light, which any number picks) and the pair.
+    /// Draws no number and changes no result.
     #[inline]
     fn prefetch_light_sample<'s>(
         &self,
@@ -627,8 +622,8 @@ impl PathIntegrator {
 struct Ahead {
     /// An escaped ray's map coordinates ([`prefetch_escaped`]).
     sky_uv: Option<Vec2>,
-    /// The light sample's numbers, peeked: the light's choice (unused with one light) and the
-    /// pair.
+    /// The light sample's numbers, peeked: the light's choice (with one light any number, as
+    /// every number picks it) and the pair.
     light_numbers: Option<(f32, Vec2)>,
 }
 
@@ -637,18 +632,13 @@ struct Ahead {
 /// only for a scene with one environment light, the one whose coordinates they are.
 #[inline]
 fn prefetch_escaped(shading: &ShadingScene, path: &PathState) -> Option<Vec2> {
-    let &[i] = shading.environment.as_slice() else {
-        for &i in &shading.environment {
-            if let Light::Environment(env) = &shading.lights[i as usize] {
-                env.prefetch_lookup(path.ray.direction.to_glam());
-            }
+    let mut uv = None;
+    for &i in &shading.environment {
+        if let Light::Environment(env) = &shading.lights[i as usize] {
+            uv = env.prefetch_lookup(path.ray.direction.to_glam());
         }
-        return None;
-    };
-    match &shading.lights[i as usize] {
-        Light::Environment(env) => env.prefetch_lookup(path.ray.direction.to_glam()),
-        _ => None,
     }
+    uv.filter(|_| shading.environment.len() == 1)
 }
 
 /// The light that number `u` in `[0, 1)` picks among `count` (at least one), uniformly.
