@@ -119,7 +119,7 @@ pub(crate) struct Parallelogram {
     pub edge_u: Vec3,
     /// The edge along which `v` runs.
     pub edge_v: Vec3,
-    /// `edge_u x edge_v` (not normalised).
+    /// `edge_u x edge_v` (not normalised), or its reverse ([`Parallelogram::mirrored`]).
     pub n: Vec3,
     /// `(edge_v x n) / |n|^2`: `s = w . to_s`.
     pub to_s: Vec3,
@@ -140,6 +140,15 @@ impl Parallelogram {
             to_s: edge_v.cross(n) / nn,
             to_v: n.cross(edge_u) / nn,
         }
+    }
+
+    /// The same parallelogram with its normal reversed, for one carried to world space by a
+    /// mirroring placement: the world edges' cross product then points against the inverse
+    /// transpose of the object normal, which the hit record's normal must follow. Its hits
+    /// are the same to the bit (`t` is a ratio of two dot products with `n`, both negated
+    /// exactly; `s` and `v` do not read `n`).
+    pub(crate) fn mirrored(self) -> Parallelogram {
+        Parallelogram { n: -self.n, ..self }
     }
 
     /// The ray's hit with `t` in `[t_min, t_max]`, if any.

@@ -249,7 +249,7 @@ impl SceneBuilder {
                     // A static quad is carried to world space once, as static triangles are:
                     // its rays then need no transform and its hits no carrying back. An affine
                     // map takes a parallelogram to one, with the same (s, v) at each point.
-                    let (quad, flip, xform) = match (&placement, xform) {
+                    let (quad, xform) = match (&placement, xform) {
                         (Placement::Static(t), Xform::Static(_)) => {
                             let m = t.matrix();
                             let quad = Parallelogram::new(
@@ -257,9 +257,14 @@ impl SceneBuilder {
                                 m.transform_vector3(edge_u),
                                 m.transform_vector3(edge_v),
                             );
-                            (quad, t.swaps_handedness(), Xform::Identity)
+                            let quad = if t.swaps_handedness() {
+                                quad.mirrored()
+                            } else {
+                                quad
+                            };
+                            (quad, Xform::Identity)
                         }
-                        (_, xform) => (Parallelogram::new(origin, edge_u, edge_v), false, xform),
+                        (_, xform) => (Parallelogram::new(origin, edge_u, edge_v), xform),
                     };
                     let b = Bounds3::from_points(
                         [
@@ -273,7 +278,7 @@ impl SceneBuilder {
                     item_bounds.push(xform.bounds(b));
                     items.push(Item::Analytic {
                         instance,
-                        shape: Analytic::Quad { quad, flip },
+                        shape: Analytic::Quad(quad),
                         xform,
                     });
                 }
@@ -372,7 +377,7 @@ fn quads_first(items: &[Item], aabbs: &[Aabb]) -> Option<Top> {
     for (index, item) in items.iter().enumerate() {
         match item {
             Item::Analytic {
-                shape: Analytic::Quad { quad, .. },
+                shape: Analytic::Quad(quad),
                 xform: Xform::Identity,
                 ..
             } => quads.push((index, *quad)),

@@ -119,12 +119,8 @@ enum Analytic {
         radius: f32,
     },
     /// A parallelogram; a static one is carried to world space when the scene is built (see
-    /// the builder), and `flip` then says that its placement mirrored it: its world edges'
-    /// cross product points against the inverse transpose of its object normal.
-    Quad {
-        quad: Parallelogram,
-        flip: bool,
-    },
+    /// the builder).
+    Quad(Parallelogram),
 }
 
 /// One entry of the top level. A scene has few, and every ray reads some, so the large

@@ -538,8 +538,8 @@ impl Scene {
                         let t = intersect_sphere(o, d, r.t_min, t_max, center, radius)?;
                         Some(Found::Sphere { item, t })
                     }
-                    Analytic::Quad { quad, .. } => {
-                        let quad = quad.intersect(o, d, r.t_min, t_max)?;
+                    Analytic::Quad(parallelogram) => {
+                        let quad = parallelogram.intersect(o, d, r.t_min, t_max)?;
                         Some(Found::Quad { item, quad })
                     }
                 }

@@ -105,25 +105,20 @@ impl Scene {
             }
             Found::Quad { item, quad } => {
                 let (instance, shape, xform) = self.analytic(item);
-                let Analytic::Quad {
-                    quad:
-                        Parallelogram {
-                            origin,
-                            edge_u,
-                            edge_v,
-                            n,
-                            ..
-                        },
-                    flip,
-                } = shape
+                let Analytic::Quad(Parallelogram {
+                    origin,
+                    edge_u,
+                    edge_v,
+                    n,
+                    ..
+                }) = shape
                 else {
                     unreachable!("Found::Quad comes from a quad")
                 };
                 let (su, sv) = (edge_u * quad.s, edge_v * quad.v);
                 let p_object = origin + su + sv;
                 let err_object = gamma(5) * (origin.abs() + su.abs() + sv.abs());
-                // A mirrored placement reversed the world edges' cross product (see `flip`).
-                let n_object = if flip { -n } else { n };
+                let n_object = n;
                 let uv = if self.uv {
                     Vec2::new(quad.s, quad.v)
                 } else {
