@@ -10,6 +10,7 @@ import json
 import math
 import os
 import pathlib
+import signal
 import subprocess
 import threading
 import _thread
@@ -290,14 +291,27 @@ def test_progress_callback_and_its_exception(perspective_scene):
 
 def test_ctrl_c_raises_keyboard_interrupt(perspective_scene):
     # interrupt_main is what the SIGINT handler does: the render's next check of the signals
-    # raises KeyboardInterrupt and stops the workers.
+    # raises KeyboardInterrupt and stops the workers. A process started in the background by a
+    # shell without job control inherits SIGINT ignored, and Python then installs no handler and
+    # interrupt_main does nothing; so the test installs Python's own handler for its duration.
+    polls = 0
+
+    def guard(done, total):
+        # The render polls every 50 ms; far more polls than the timer's 0.2 s means the interrupt
+        # was lost. Failing here ends the 100000-spp render instead of hanging the suite.
+        nonlocal polls
+        polls += 1
+        assert polls < 600, "Ctrl-C did not stop the render"
+
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
     timer = threading.Timer(0.2, _thread.interrupt_main)
     timer.start()
     try:
         with pytest.raises(KeyboardInterrupt):
-            obscura.render(perspective_scene, spp=100000, threads=1)
+            obscura.render(perspective_scene, spp=100000, threads=1, progress=guard)
     finally:
         timer.cancel()
+        signal.signal(signal.SIGINT, previous)
 
 
 # Bad input: each a Python exception with a message that says what is wrong.
