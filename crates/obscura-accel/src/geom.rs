@@ -200,6 +200,27 @@ impl AbsAffine {
             translation: m.w_axis.truncate().abs(),
         }
     }
+
+    /// The absolute values of `m_inv m - I`, computed in f64 from the f32 matrices (exactly
+    /// representable there) and rounded up once: how far `m_inv` is from inverting `m`.
+    pub(crate) fn inverse_residual(m: &Mat4, m_inv: &Mat4) -> AbsAffine {
+        let r = m_inv.as_dmat4() * m.as_dmat4() - glam::DMat4::IDENTITY;
+        let up = |v: f64| (v.abs() * (1.0 + f64::from(f32::EPSILON))) as f32;
+        AbsAffine {
+            linear: glam::Mat3::from_cols_array(&[
+                up(r.x_axis.x),
+                up(r.x_axis.y),
+                up(r.x_axis.z),
+                up(r.y_axis.x),
+                up(r.y_axis.y),
+                up(r.y_axis.z),
+                up(r.z_axis.x),
+                up(r.z_axis.y),
+                up(r.z_axis.z),
+            ]),
+            translation: Vec3::new(up(r.w_axis.x), up(r.w_axis.y), up(r.w_axis.z)),
+        }
+    }
 }
 
 /// Maps a point with an absolute error bound through the affine matrix `m` (whose absolute
@@ -245,18 +266,30 @@ pub(crate) fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec
     po
 }
 
-/// The extra error of a hit found in object space: the ray's origin was carried there with
-/// `object_from_world` (rounded), so the surface point is uncertain by that rounding, mapped
-/// back to world space. Without it, spawned rays far from the origin re-hit moving surfaces.
-/// Takes the absolute values of both matrices ([`AbsAffine`]).
+/// The extra error of a hit found in object space, mapped back to world space. Takes the
+/// absolute values of both matrices ([`AbsAffine`]) and of the stored inverse's residual
+/// ([`AbsAffine::inverse_residual`]). Two things put the object-space point off the world
+/// ray:
+/// - the ray's origin was carried there with `object_from_world` (rounded), so the surface
+///   point is uncertain by that rounding. Without it, spawned rays far from the origin re-hit
+///   moving surfaces;
+/// - the stored inverse `N` is not the exact inverse of `M = world_from_object` (each factor of
+///   a composed transform was inverted and rounded on its own). The ray met the surface where
+///   `N x = p_object`, at `x = N^-1 p_object`, but the hit reports `M p_object`. With
+///   `R = N M - I`, `N^-1 - M = -M R (I + R)^-1`, so the two differ by at most
+///   `|M| |R| (|p_object|, 1)` to first order (`|R|` is a few ulps). Without it, rays spawned
+///   into a scaled sphere met its surface again next to where they left it.
 pub(crate) fn object_space_error(
     abs_world_from_object: &AbsAffine,
     abs_object_from_world: &AbsAffine,
+    abs_residual: &AbsAffine,
     p_world: Vec3,
+    p_object: Vec3,
 ) -> Vec3 {
-    let err_object = gamma(4)
+    let carried = gamma(4)
         * (abs_object_from_world.linear * p_world.abs() + abs_object_from_world.translation);
-    (1.0 + gamma(3)) * (abs_world_from_object.linear * err_object)
+    let mismatch = abs_residual.linear * p_object.abs() + abs_residual.translation;
+    (1.0 + gamma(3)) * (abs_world_from_object.linear * (carried + mismatch))
 }
 
 /// The next representable f32 above `v` (identity for +inf and NaN).
@@ -377,5 +410,24 @@ mod tests {
         // |n| . err = 1e-3 along z: above and below p by at least that.
         assert!(up.z >= 1.001 && up.x == 0.0);
         assert!(down.z <= 0.999 && down.x == 0.0);
+    }
+
+    #[test]
+    fn inverse_residual_measures_how_far_an_inverse_misses() {
+        // Scaling by 2 and by 0.5 are exact inverses: no residual.
+        let m = Mat4::from_scale(Vec3::splat(2.0));
+        let exact = AbsAffine::inverse_residual(&m, &Mat4::from_scale(Vec3::splat(0.5)));
+        assert_eq!(exact.linear, glam::Mat3::ZERO);
+        assert_eq!(exact.translation, Vec3::ZERO);
+        // Nudge the inverse's x scale one ulp above 0.5 (2^-24) and its x translation by 2^-20:
+        // m_inv m - I is 2 * 2^-24 = 2^-23 at (0, 0) and 2^-20 in the translation, nothing else.
+        let mut nudged = Mat4::from_scale(Vec3::splat(0.5));
+        nudged.x_axis.x = next_float_up(0.5);
+        nudged.w_axis.x = 2f32.powi(-20);
+        let r = AbsAffine::inverse_residual(&m, &nudged);
+        assert!(r.linear.x_axis.x >= 2f32.powi(-23) && r.linear.x_axis.x < 1.01 * 2f32.powi(-23));
+        assert!(r.translation.x >= 2f32.powi(-20) && r.translation.x < 1.01 * 2f32.powi(-20));
+        assert_eq!(r.linear.y_axis, Vec3::ZERO);
+        assert_eq!((r.translation.y, r.translation.z), (0.0, 0.0));
     }
 }

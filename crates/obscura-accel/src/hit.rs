@@ -14,7 +14,9 @@ pub struct Hit {
     pub t: f32,
     /// The hit point.
     pub p: Point3<World>,
-    /// A conservative absolute error bound of `p`, per axis (pbrt style).
+    /// A conservative absolute error bound of `p`, per axis (pbrt style): of `p` itself, and of
+    /// where the intersection tests place the surface relative to a ray leaving `p` (a
+    /// triangle's test, a transform's rounded inverse), so that [`Hit::spawn_ray`] clears it.
     pub p_error: Vector3<World>,
     /// Unit geometric normal with the shape's own orientation, not flipped towards the ray:
     /// spheres outward, quads `normalize(cross(edge_u, edge_v))`, triangles by winding

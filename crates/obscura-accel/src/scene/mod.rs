@@ -74,12 +74,14 @@ enum Xform {
 }
 
 /// A static placement with what every ray and hit through it reads, computed once: the
-/// absolute values of both matrices, which the hit's error bound is made of.
+/// absolute values of both matrices and of the inverse's residual, which the hit's error bound
+/// is made of.
 #[derive(Debug, Clone)]
 struct Placed {
     world_from_object: Transform<World, Object>,
     abs: AbsAffine,
     abs_inverse: AbsAffine,
+    abs_residual: AbsAffine,
 }
 
 impl Placed {
@@ -88,6 +90,10 @@ impl Placed {
             world_from_object,
             abs: AbsAffine::of(&world_from_object.matrix()),
             abs_inverse: AbsAffine::of(&world_from_object.inverse_matrix()),
+            abs_residual: AbsAffine::inverse_residual(
+                &world_from_object.matrix(),
+                &world_from_object.inverse_matrix(),
+            ),
         }
     }
 }

@@ -22,11 +22,12 @@ impl Scene {
                 let mesh = self.meshes[instance as usize]
                     .as_ref()
                     .expect("flattened instances are meshes");
-                let (p, p_error) = edge_point(&hit);
+                let cross = hit.e1.cross(hit.e2);
+                let (p, p_error) = edge_point(&hit, cross);
                 // The world edges already carry the transform: (M a) x (M b) =
                 // det(M) M^-T (a x b), so flip for a mirroring transform to match the inverse
                 // transpose of the object-space winding normal.
-                let mut n_geo = hit.e1.cross(hit.e2).normalize();
+                let mut n_geo = cross.normalize();
                 if world_from_object.swaps_handedness() {
                     n_geo = -n_geo;
                 }
@@ -55,9 +56,9 @@ impl Scene {
                     .as_ref()
                     .expect("moving mesh instances are meshes");
                 let placed = Placed::new(world_from_object.at(r.time));
-                let (p_object, err_object) = edge_point(&hit);
-                let (p, p_error, n_geo) =
-                    placed.hit_to_world(p_object, err_object, hit.e1.cross(hit.e2));
+                let cross = hit.e1.cross(hit.e2);
+                let (p_object, err_object) = edge_point(&hit, cross);
+                let (p, p_error, n_geo) = placed.hit_to_world(p_object, err_object, cross);
                 self.triangle_hit(
                     r,
                     hit.tri,
@@ -236,7 +237,14 @@ impl Placed {
         let (p, p_error) = transform_point_with_error(&m, &self.abs, p_object, err_object);
         (
             p,
-            p_error + object_space_error(&self.abs, &self.abs_inverse, p),
+            p_error
+                + object_space_error(
+                    &self.abs,
+                    &self.abs_inverse,
+                    &self.abs_residual,
+                    p,
+                    p_object,
+                ),
         )
     }
 
@@ -266,10 +274,28 @@ fn normal_to_world(world_from_object: &Transform<World, Object>, n_object: Vec3)
 /// stored, so `gamma(4) (|v0| + |b1 e1| + |b2 e2|)` covers it; pbrt's `gamma(7)` on the same
 /// terms is kept for margin (the barycentrics themselves carry error within the plane, which
 /// moves the point along the surface, not off it).
+///
+/// The bound is widened along the normal by how far off the plane the four-wide
+/// Möller–Trumbore test can place a spawned ray's origin, so that the spawned ray cannot meet
+/// the triangle again. The test's `t` numerator is `e2 . ((o - v0) x e1)`, the origin's signed
+/// distance from the plane times `|e1 x e2|`. With `w = o - v0` rounded (`gamma(1) |w|`), the
+/// cross product (`gamma(2)`) and the dot product (`gamma(3)`), its error is at most
+/// `gamma(5) |e2|_1 |w|_1 |e1|_1 + gamma(1) |w|_1 |e1 x e2|`; divided by `|e1 x e2|`, as a
+/// distance, that is `gamma(6) |w|_1 (|e1|_1 |e2|_1 / |e1 x e2| + 1)` with
+/// `|w|_1 <= b1 |e1|_1 + b2 |e2|_1`. It grows as the triangle thins (`|e1 x e2|` small
+/// beside its edges); the point's own bound alone let thin triangles be met again. `cross` is
+/// `e1 x e2`, which the caller needs for the normal too.
 #[inline]
-fn edge_point(hit: &WideHit) -> (Vec3, Vec3) {
+fn edge_point(hit: &WideHit, cross: Vec3) -> (Vec3, Vec3) {
     let (a, b, c) = (hit.v0, hit.e1 * hit.tri.b1, hit.e2 * hit.tri.b2);
     let p = a + b + c;
-    let err = gamma(7) * (a.abs() + b.abs() + c.abs());
+    let mut err = gamma(7) * (a.abs() + b.abs() + c.abs());
+    let area = cross.length();
+    if area > 0.0 {
+        let (l1, l2) = (hit.e1.abs().element_sum(), hit.e2.abs().element_sum());
+        let reach = hit.tri.b1.abs() * l1 + hit.tri.b2.abs() * l2;
+        let plane = gamma(6) * reach * (l1 * l2 / area + 1.0);
+        err += (cross / area).abs() * plane;
+    }
     (p, err)
 }
