@@ -346,6 +346,17 @@ impl<'a> SearchStart<'a> {
     pub fn searched_cell(&self) -> &'a GridCell {
         &self.cells[self.cells[self.bucket].bin().guide as usize]
     }
+
+    /// The cells either side of [`SearchStart::searched_cell`], which the sample reads too
+    /// when its bin is the one before the first compared (or after it).
+    #[inline]
+    pub fn searched_neighbours(&self) -> [&'a GridCell; 2] {
+        let lo = self.cells[self.bucket].bin().guide as usize;
+        [
+            &self.cells[lo.saturating_sub(1)],
+            &self.cells[(lo + 1).min(self.cells.len() - 1)],
+        ]
+    }
 }
 
 impl Distribution2D {
@@ -591,6 +602,9 @@ mod tests {
             prop_assert!(std::ptr::eq(start.guide_cell(), &row.cells[bucket(ux, w)]));
             let lo = row.cells[bucket(ux, w)].bin().guide as usize;
             prop_assert!(std::ptr::eq(start.searched_cell(), &row.cells[lo]));
+            let [before, after] = start.searched_neighbours();
+            prop_assert!(std::ptr::eq(before, &row.cells[lo.saturating_sub(1)]));
+            prop_assert!(std::ptr::eq(after, &row.cells[(lo + 1).min(w)]));
             prop_assert!(lo <= row.count_at_or_below(ux));
         }
 

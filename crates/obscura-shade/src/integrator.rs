@@ -356,6 +356,9 @@ impl PathIntegrator {
                 }
                 for search in &searches {
                     obscura_accel::prefetch(search.searched_cell(), 0);
+                    for cell in search.searched_neighbours() {
+                        obscura_accel::prefetch(cell, 0);
+                    }
                 }
             }
             going_on.clear();
