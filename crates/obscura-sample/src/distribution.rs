@@ -170,7 +170,12 @@ impl<C: HasBin> Row<'_, C> {
 
     #[inline]
     fn sample_continuous(&self, u: f32) -> (f32, f32, usize) {
-        let i = self.find(u);
+        self.sample_continuous_in(u, self.find(u))
+    }
+
+    /// [`Row::sample_continuous`] in bin `i`, which must be `self.find(u)`.
+    #[inline(always)]
+    fn sample_continuous_in(&self, u: f32, i: usize) -> (f32, f32, usize) {
         let (c0, c1) = (self.cells[i].bin().cdf, self.cells[i + 1].bin().cdf);
         let du = if c1 > c0 { (u - c0) / (c1 - c0) } else { 0.5 };
         let x = ((i as f32 + du.clamp(0.0, 1.0)) / self.len() as f32).min(ONE_MINUS_EPSILON);
@@ -332,6 +337,7 @@ pub struct Distribution2D<S = Vec<GridCell>> {
 pub struct SearchStart<'a> {
     cells: &'a [GridCell],
     bucket: usize,
+    row: usize,
 }
 
 impl<'a> SearchStart<'a> {
@@ -339,6 +345,13 @@ impl<'a> SearchStart<'a> {
     #[inline]
     pub fn guide_cell(&self) -> &'a GridCell {
         &self.cells[self.bucket]
+    }
+
+    /// The row the sample picked (the marginal's bin), for
+    /// [`Distribution2D::sample_with_value_in_row`].
+    #[inline]
+    pub fn row(&self) -> usize {
+        self.row
     }
 
     /// The first cell the search then compares, found by reading the guide entry.
@@ -449,8 +462,10 @@ impl<S: Deref<Target = [GridCell]>> Distribution2D<S> {
     /// its first load, which nothing before it predicts, for a caller to prefetch.
     #[inline]
     pub fn search_start(&self, u2: Vec2) -> SearchStart<'_> {
-        let row = self.row_at(self.marginal.row().find(u2.y));
+        let y = self.marginal.row().find(u2.y);
+        let row = self.row_at(y);
         SearchStart {
+            row: y,
             cells: row.cells,
             bucket: bucket(u2.x, row.len()),
         }
@@ -469,6 +484,17 @@ impl<S: Deref<Target = [GridCell]>> Distribution2D<S> {
     pub fn sample_with_value(&self, u2: Vec2) -> (Vec2, f32, Vec3) {
         let (p, pdf) = self.sample(u2);
         (p, pdf, self.value(p))
+    }
+
+    /// [`Distribution2D::sample_with_value`] given the row the sample picks, which must be
+    /// [`SearchStart::row`] of [`Distribution2D::search_start`] for the same `u2`: the
+    /// marginal's search is not made again. The same result to the bit.
+    #[inline]
+    pub fn sample_with_value_in_row(&self, u2: Vec2, row: usize) -> (Vec2, f32, Vec3) {
+        let (v, pdf_v, y) = self.marginal.row().sample_continuous_in(u2.y, row);
+        let (u, pdf_u, _) = self.row_at(y).sample_continuous(u2.x);
+        let p = Vec2::new(u, v);
+        (p, pdf_u * pdf_v, self.value(p))
     }
 
     /// The density at `(u, v)` in `[0, 1)^2`.
@@ -602,6 +628,8 @@ mod tests {
             prop_assert!(std::ptr::eq(start.guide_cell(), &row.cells[bucket(ux, w)]));
             let lo = row.cells[bucket(ux, w)].bin().guide as usize;
             prop_assert!(std::ptr::eq(start.searched_cell(), &row.cells[lo]));
+            prop_assert_eq!(start.row(), d.marginal.sample_continuous(uy).2);
+            prop_assert_eq!(d.sample_with_value_in_row(Vec2::new(ux, uy), start.row()), (p, pdf, value));
             let [before, after] = start.searched_neighbours();
             prop_assert!(std::ptr::eq(before, &row.cells[lo.saturating_sub(1)]));
             prop_assert!(std::ptr::eq(after, &row.cells[(lo + 1).min(w)]));

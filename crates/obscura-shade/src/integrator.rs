@@ -488,15 +488,19 @@ impl PathIntegrator {
             // With one light there is nothing to choose: the number is skipped, not drawn.
             // Numbers the sweep peeked are moved past, not computed again (with one light its
             // choice is any number: every number picks light 0).
-            let (u_light, u2_light) = match ahead.light_numbers {
+            let numbers = match ahead.light_numbers {
                 Some(numbers) => {
                     dims.skip_1d();
                     dims.skip_2d();
                     numbers
                 }
-                None => (dims.next_1d_if(shading.lights.len() > 1), dims.next_2d()),
+                None => LightNumbers {
+                    choice: dims.next_1d_if(shading.lights.len() > 1),
+                    pair: dims.next_2d(),
+                    map_row: None,
+                },
             };
-            match self.sample_light(shading, &hit, material, &frame, wo, u_light, u2_light) {
+            match self.sample_light(shading, &hit, material, &frame, wo, numbers) {
                 Some((value, ray)) => {
                     shadow = Some(Shadow {
                         beta: path.beta,
@@ -547,8 +551,8 @@ impl PathIntegrator {
     /// Asks the cache for the guide entry of the light sample the path's coming vertex at
     /// `hit` will search the environment map with (when the vertex will sample a light and
     /// the peeked numbers pick the map), and returns the search's start and the numbers it
-    /// peeked: the light's choice (0 with one light, which any number picks) and the pair.
-    /// Draws no number and changes no result.
+    /// peeked (the light's choice is 0 with one light, which any number picks), with the map
+    /// row they pick. Draws no number and changes no result.
     #[inline]
     fn prefetch_light_sample<'s>(
         &self,
@@ -556,7 +560,7 @@ impl PathIntegrator {
         path: &PathState,
         hit: &Hit,
         dims: &mut impl SampleDims,
-    ) -> Option<(SearchStart<'s>, (f32, Vec2))> {
+    ) -> Option<(SearchStart<'s>, LightNumbers)> {
         // The vertex goes on to shading (and perhaps a light sample) only below the depth limit.
         let samples_light = path.depth < self.max_depth
             && shading
@@ -574,7 +578,12 @@ impl PathIntegrator {
         let u2 = dims.peek_2d(1)?;
         let start = env.sample_start(u2)?;
         obscura_accel::prefetch(start.guide_cell(), 0);
-        Some((start, (u_light, u2)))
+        let numbers = LightNumbers {
+            choice: u_light,
+            pair: u2,
+            map_row: Some(start.row()),
+        };
+        Some((start, numbers))
     }
 
     /// One light sample at `hit`, MIS-weighted against BSDF sampling: its value if nothing
@@ -587,14 +596,16 @@ impl PathIntegrator {
         material: &Material,
         frame: &Frame,
         wo: Vec3,
-        u_light: f32,
-        u2_light: Vec2,
+        numbers: LightNumbers,
     ) -> Option<(Vec3, Ray<World>)> {
         let count = shading.lights.len();
-        let index = light_index(u_light, count);
+        let index = light_index(numbers.choice, count);
         let light_select = 1.0 / count as f32;
         let p = hit.p.to_glam();
-        let ls = shading.lights[index].sample_li(p, hit.time, u2_light)?;
+        let ls = match &shading.lights[index] {
+            Light::Environment(env) => env.sample_li_in_row(numbers.pair, numbers.map_row),
+            light => light.sample_li(p, hit.time, numbers.pair),
+        }?;
         if ls.radiance == Vec3::ZERO || (!ls.delta && ls.pdf < MIN_PDF) {
             return None;
         }
@@ -625,9 +636,20 @@ impl PathIntegrator {
 struct Ahead {
     /// An escaped ray's map coordinates ([`prefetch_escaped`]).
     sky_uv: Option<Vec2>,
-    /// The light sample's numbers, peeked: the light's choice (with one light any number, as
-    /// every number picks it) and the pair.
-    light_numbers: Option<(f32, Vec2)>,
+    /// The light sample's numbers, peeked, and the map row they pick.
+    light_numbers: Option<LightNumbers>,
+}
+
+/// A light sample's numbers, and what the prefetch sweep found with them.
+#[derive(Clone, Copy, Debug)]
+struct LightNumbers {
+    /// The light's choice (with one light any number, as every number picks it).
+    choice: f32,
+    /// The pair the light samples with.
+    pair: Vec2,
+    /// The environment map's row the pair picks, when the sweep found it for the chosen
+    /// light (`EnvironmentLight::sample_li_in_row`).
+    map_row: Option<usize>,
 }
 
 /// Asks the cache for the environment map's cell an escaped path's vertex will read, and

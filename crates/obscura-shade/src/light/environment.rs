@@ -123,6 +123,14 @@ impl EnvironmentLight {
 
     /// Samples a direction (by luminance for maps, uniformly for a constant).
     pub fn sample_li(&self, u2: Vec2) -> Option<LightSample> {
+        self.sample_li_in_row(u2, None)
+    }
+
+    /// [`EnvironmentLight::sample_li`], given the map row the sample picks when the caller has
+    /// it: `row` must be [`SearchStart::row`] of [`EnvironmentLight::sample_start`] for the
+    /// same `u2` (`None`: found here).
+    #[inline]
+    pub fn sample_li_in_row(&self, u2: Vec2, row: Option<usize>) -> Option<LightSample> {
         match &self.kind {
             EnvironmentKind::Constant(l) => Some(LightSample {
                 wi: square_to_uniform_sphere(u2),
@@ -132,7 +140,10 @@ impl EnvironmentLight {
                 delta: false,
             }),
             EnvironmentKind::Map(map) => {
-                let (uv, pdf_uv, radiance) = map.distribution.sample_with_value(u2);
+                let (uv, pdf_uv, radiance) = match row {
+                    Some(row) => map.distribution.sample_with_value_in_row(u2, row),
+                    None => map.distribution.sample_with_value(u2),
+                };
                 let sin_theta = (PI * uv.y).sin();
                 if pdf_uv <= 0.0 || sin_theta <= TINY {
                     return None;
