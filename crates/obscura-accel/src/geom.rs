@@ -202,23 +202,17 @@ impl AbsAffine {
     }
 
     /// The absolute values of `m_inv m - I`, computed in f64 from the f32 matrices (exactly
-    /// representable there) and rounded up once: how far `m_inv` is from inverting `m`.
+    /// representable there) and rounded up once: how far `m_inv` is from inverting `m`. Both
+    /// are affine, so only the linear part and the translation are multiplied out.
     pub(crate) fn inverse_residual(m: &Mat4, m_inv: &Mat4) -> AbsAffine {
-        let r = m_inv.as_dmat4() * m.as_dmat4() - glam::DMat4::IDENTITY;
-        let up = |v: f64| (v.abs() * (1.0 + f64::from(f32::EPSILON))) as f32;
+        let linear = |a: &Mat4| glam::Mat3::from_mat4(*a).as_dmat3();
+        let (n, n_t) = (linear(m_inv), m_inv.w_axis.truncate().as_dvec3());
+        let r = n * linear(m) - glam::DMat3::IDENTITY;
+        let r_t = n * m.w_axis.truncate().as_dvec3() + n_t;
+        let up = |v: glam::DVec3| (v.abs() * (1.0 + f64::from(f32::EPSILON))).as_vec3();
         AbsAffine {
-            linear: glam::Mat3::from_cols_array(&[
-                up(r.x_axis.x),
-                up(r.x_axis.y),
-                up(r.x_axis.z),
-                up(r.y_axis.x),
-                up(r.y_axis.y),
-                up(r.y_axis.z),
-                up(r.z_axis.x),
-                up(r.z_axis.y),
-                up(r.z_axis.z),
-            ]),
-            translation: Vec3::new(up(r.w_axis.x), up(r.w_axis.y), up(r.w_axis.z)),
+            linear: glam::Mat3::from_cols(up(r.x_axis), up(r.y_axis), up(r.z_axis)),
+            translation: up(r_t),
         }
     }
 }
