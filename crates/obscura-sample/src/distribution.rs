@@ -488,9 +488,11 @@ impl<S: Deref<Target = [GridCell]>> Distribution2D<S> {
 
     /// [`Distribution2D::sample_with_value`] given the row the sample picks, which must be
     /// [`SearchStart::row`] of [`Distribution2D::search_start`] for the same `u2`: the
-    /// marginal's search is not made again. The same result to the bit.
+    /// marginal's search is not made again. The same result to the bit. A row past the last
+    /// is taken as the last.
     #[inline]
     pub fn sample_with_value_in_row(&self, u2: Vec2, row: usize) -> (Vec2, f32, Vec3) {
+        let row = row.min(self.marginal.len() - 1);
         let (v, pdf_v, y) = self.marginal.row().sample_continuous_in(u2.y, row);
         let (u, pdf_u, _) = self.row_at(y).sample_continuous(u2.x);
         let p = Vec2::new(u, v);
@@ -630,6 +632,9 @@ mod tests {
             prop_assert!(std::ptr::eq(start.searched_cell(), &row.cells[lo]));
             prop_assert_eq!(start.row(), d.marginal.sample_continuous(uy).2);
             prop_assert_eq!(d.sample_with_value_in_row(Vec2::new(ux, uy), start.row()), (p, pdf, value));
+            // A row past the last is the last, not a panic.
+            let last = d.sample_with_value_in_row(Vec2::new(ux, uy), h - 1);
+            prop_assert_eq!(d.sample_with_value_in_row(Vec2::new(ux, uy), usize::MAX), last);
             let [before, after] = start.searched_neighbours();
             prop_assert!(std::ptr::eq(before, &row.cells[lo.saturating_sub(1)]));
             prop_assert!(std::ptr::eq(after, &row.cells[(lo + 1).min(w)]));
