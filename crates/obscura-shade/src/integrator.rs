@@ -331,22 +331,26 @@ impl PathIntegrator {
             next_rays.extend(live.iter().map(|(_, path)| path.ray));
             let hits = geometry.intersect_batch(&next_rays);
             if shading.has_environment_map() {
-                // Ask for the map's cells in two sweeps: the lines each vertex reads first,
-                // then, once the guide entries have come, the cells the searches compare.
+                // Ask for the map's cells in two steps: the lines each vertex reads first, in
+                // this sweep; then the cells a light sample's search compares, found from its
+                // guide entry a few vertices ahead of it in the loop below.
                 // What the sweep found on the way (an escaped path's map coordinates, a light
                 // sample's peeked numbers) is kept for the vertex, which need not find it again.
                 searches.clear();
                 ahead.clear();
                 for ((slot, path), hit) in live.iter().zip(&hits) {
                     ahead.push(match hit {
-                        None => Ahead {
-                            sky_uv: prefetch_escaped(shading, path),
-                            light_numbers: None,
-                        },
+                        None => {
+                            searches.push(None);
+                            Ahead {
+                                sky_uv: prefetch_escaped(shading, path),
+                                light_numbers: None,
+                            }
+                        }
                         Some(hit) => {
                             let found =
                                 self.prefetch_light_sample(shading, path, hit, &mut dims[*slot]);
-                            searches.extend(found.map(|(start, _)| start));
+                            searches.push(found.map(|(start, _)| start));
                             Ahead {
                                 sky_uv: None,
                                 light_numbers: found.map(|(_, numbers)| numbers),
@@ -354,15 +358,15 @@ impl PathIntegrator {
                         }
                     });
                 }
-                for search in &searches {
-                    obscura_accel::prefetch(search.searched_cell(), 0);
-                    for cell in search.searched_neighbours() {
-                        obscura_accel::prefetch(cell, 0);
-                    }
+                for search in searches.iter().take(SEARCH_AHEAD).flatten() {
+                    prefetch_searched(search);
                 }
             }
             going_on.clear();
             for (k, ((slot, path), hit)) in live.iter_mut().zip(hits).enumerate() {
+                if let Some(Some(search)) = searches.get(k + SEARCH_AHEAD) {
+                    prefetch_searched(search);
+                }
                 let found = ahead.get(k).copied().unwrap_or_default();
                 let (shadow, more) = self.vertex(shading, path, hit, found, &mut dims[*slot]);
                 if let Some(shadow) = shadow {
@@ -650,6 +654,20 @@ struct LightNumbers {
     /// The environment map's row the pair picks, when the sweep found it for the chosen
     /// light (`EnvironmentLight::sample_li_in_row`).
     map_row: Option<usize>,
+}
+
+/// How many vertices ahead of its own the batched loop asks for a light sample's searched
+/// cells: late enough that the search's guide entry has come, early enough that the cells
+/// come before the vertex.
+const SEARCH_AHEAD: usize = 8;
+
+/// Asks the cache for the cells a light sample's search compares: the first and either side.
+#[inline]
+fn prefetch_searched(search: &SearchStart<'_>) {
+    obscura_accel::prefetch(search.searched_cell(), 0);
+    for cell in search.searched_neighbours() {
+        obscura_accel::prefetch(cell, 0);
+    }
 }
 
 /// Asks the cache for the environment map's cell an escaped path's vertex will read, and
