@@ -354,19 +354,15 @@ impl<'a> SearchStart<'a> {
         self.row
     }
 
-    /// The first cell the search then compares, found by reading the guide entry.
+    /// The first cell the search then compares, found by reading the guide entry, and the
+    /// cells either side of it, which the sample reads too when its bin is the one before the
+    /// first compared (or after it): `[before, first, after]`, clamped to the row.
     #[inline]
-    pub fn searched_cell(&self) -> &'a GridCell {
-        &self.cells[self.cells[self.bucket].bin().guide as usize]
-    }
-
-    /// The cells either side of [`SearchStart::searched_cell`], which the sample reads too
-    /// when its bin is the one before the first compared (or after it).
-    #[inline]
-    pub fn searched_neighbours(&self) -> [&'a GridCell; 2] {
+    pub fn searched_cells(&self) -> [&'a GridCell; 3] {
         let lo = self.cells[self.bucket].bin().guide as usize;
         [
             &self.cells[lo.saturating_sub(1)],
+            &self.cells[lo],
             &self.cells[(lo + 1).min(self.cells.len() - 1)],
         ]
     }
@@ -629,13 +625,14 @@ mod tests {
             let start = d.search_start(Vec2::new(ux, uy));
             prop_assert!(std::ptr::eq(start.guide_cell(), &row.cells[bucket(ux, w)]));
             let lo = row.cells[bucket(ux, w)].bin().guide as usize;
-            prop_assert!(std::ptr::eq(start.searched_cell(), &row.cells[lo]));
+
             prop_assert_eq!(start.row(), d.marginal.sample_continuous(uy).2);
             prop_assert_eq!(d.sample_with_value_in_row(Vec2::new(ux, uy), start.row()), (p, pdf, value));
             // A row past the last is the last, not a panic.
             let last = d.sample_with_value_in_row(Vec2::new(ux, uy), h - 1);
             prop_assert_eq!(d.sample_with_value_in_row(Vec2::new(ux, uy), usize::MAX), last);
-            let [before, after] = start.searched_neighbours();
+            let [before, first, after] = start.searched_cells();
+            prop_assert!(std::ptr::eq(first, &row.cells[lo]));
             prop_assert!(std::ptr::eq(before, &row.cells[lo.saturating_sub(1)]));
             prop_assert!(std::ptr::eq(after, &row.cells[(lo + 1).min(w)]));
             prop_assert!(lo <= row.count_at_or_below(ux));

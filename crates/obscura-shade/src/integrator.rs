@@ -664,8 +664,7 @@ const SEARCH_AHEAD: usize = 8;
 /// Asks the cache for the cells a light sample's search compares: the first and either side.
 #[inline]
 fn prefetch_searched(search: &SearchStart<'_>) {
-    obscura_accel::prefetch(search.searched_cell(), 0);
-    for cell in search.searched_neighbours() {
+    for cell in search.searched_cells() {
         obscura_accel::prefetch(cell, 0);
     }
 }
