@@ -3,9 +3,7 @@
 //! Everything here works in one space (whichever the caller's ray is in) and knows nothing of
 //! instances; the scene carries rays and hits between spaces.
 
-#[cfg(test)]
-use glam::Vec3A;
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Vec3, Vec3A};
 
 /// pbrt's `gamma(n) = n * eps / (1 - n * eps)`, with `eps` half an ulp of 1: a bound on the
 /// relative error of `n` chained roundings.
@@ -242,22 +240,10 @@ pub(crate) fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec
     // At least 1e-20: a surface with exact coordinates (a quad in the plane z = 0) has a zero
     // error bound, and an origin left exactly on it would meet it again at t = -0 = 0.
     let d = n.abs().dot(p_error).max(MIN_OFFSET);
-    let mut offset = n * d;
-    if w.dot(n) < 0.0 {
-        offset = -offset;
-    }
-    let side = if w.dot(n) < 0.0 { -n } else { n };
-    let mut po = p + offset;
-    // Round away from p so that rounding in the addition cannot pull the origin back; this
-    // also moves an origin whose error bound is exactly zero (a plane through 0) off the plane.
-    for i in 0..3 {
-        if side[i] > 0.0 {
-            po[i] = next_float_up(po[i]);
-        } else if side[i] < 0.0 {
-            po[i] = next_float_down(po[i]);
-        }
-    }
-    po
+    // Then one float further along the normal turned to w's side, so that rounding in the
+    // addition cannot pull the origin back; this also moves an origin whose error bound is
+    // exactly zero (a plane through 0) off the plane.
+    crate::simd::offset_point(Vec3A::from(p), Vec3A::from(n), d, w.dot(n)).into()
 }
 
 /// The extra error of a hit found in object space, mapped back to world space. Takes the
@@ -286,7 +272,9 @@ pub(crate) fn object_space_error(
     (1.0 + gamma(3)) * (abs_world_from_object.linear * (carried + mismatch))
 }
 
-/// The next representable f32 above `v` (identity for +inf and NaN).
+/// The next representable f32 above `v` (identity for +inf and NaN). The portable steps of
+/// [`offset_ray_origin`]; x86-64 takes the same steps on the bits (`crate::simd`).
+#[cfg(any(test, not(target_arch = "x86_64")))]
 pub(crate) fn next_float_up(v: f32) -> f32 {
     if v.is_infinite() && v > 0.0 || v.is_nan() {
         return v;
@@ -298,6 +286,7 @@ pub(crate) fn next_float_up(v: f32) -> f32 {
 }
 
 /// The next representable f32 below `v`.
+#[cfg(any(test, not(target_arch = "x86_64")))]
 pub(crate) fn next_float_down(v: f32) -> f32 {
     -next_float_up(-v)
 }
