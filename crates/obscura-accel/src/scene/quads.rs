@@ -213,6 +213,23 @@ mod tests {
     }
 
     #[test]
+    fn of_quads_hit_at_the_same_t_the_later_wins() {
+        // Copies of one quad at slots 0 and 4 (the same lane of two groups) and at slots 1 and
+        // 2 (two lanes of one group), the others elsewhere: the later copy of each pair wins.
+        let near = Parallelogram::new(Vec3::new(-1.0, -1.0, 1.0), 2.0 * Vec3::X, 2.0 * Vec3::Y);
+        let far = Parallelogram::new(Vec3::new(-1.0, -1.0, 5.0), 2.0 * Vec3::X, 2.0 * Vec3::Y);
+        let (o, d) = (Vec3A::ZERO, Vec3A::Z);
+        for (copies, want) in [([0, 4], 14), ([1, 2], 12), ([3, 7], 17)] {
+            let quads: Vec<_> = (0..8)
+                .map(|k| (10 + k, if copies.contains(&k) { near } else { far }))
+                .collect();
+            let set = QuadSet::new(&quads).unwrap();
+            let (item, hit) = set.closest(o, d, 0.0, f32::INFINITY).unwrap();
+            assert_eq!((item, hit.t), (want, 1.0), "copies at {copies:?}");
+        }
+    }
+
+    #[test]
     fn more_quads_than_the_capacity_are_refused() {
         let quad = Parallelogram::new(Vec3::ZERO, Vec3::X, Vec3::Y);
         let quads: Vec<_> = (0..=QuadSet::CAPACITY).map(|i| (i, quad)).collect();
