@@ -29,6 +29,55 @@ pub struct AreaLight {
     /// Boxed: transforms are large, and [`Light`](super::Light)'s variants should stay close
     /// in size.
     placement: Box<Placement>,
+    /// A quad that does not move, in world space once for all its samples (every light sample
+    /// would otherwise carry its corner and edges there and find its area again).
+    fixed_quad: Option<Box<WorldQuad>>,
+}
+
+/// A quad in world space: what sampling it by area and its density need.
+#[derive(Debug, Clone)]
+struct WorldQuad {
+    origin: Vec3,
+    edge_u: Vec3,
+    edge_v: Vec3,
+    /// The unit normal on the emitting side.
+    n: Vec3,
+    /// One over the area; `None` for a quad too small to sample.
+    pdf_area: Option<f32>,
+}
+
+impl WorldQuad {
+    /// The quad placed by `world_from_object`, computed as [`AreaLight::sample_area`] and
+    /// [`AreaLight::pdf_area`] compute it at every sample, so either gives the same bits.
+    fn new(
+        world_from_object: &Transform<World, Object>,
+        origin: Vec3,
+        edge_u: Vec3,
+        edge_v: Vec3,
+    ) -> WorldQuad {
+        let m = world_from_object.matrix();
+        let orientation = orientation_sign(&m);
+        let eu = m.transform_vector3(edge_u);
+        let ev = m.transform_vector3(edge_v);
+        let cross = eu.cross(ev);
+        let area = cross.length();
+        WorldQuad {
+            origin: m.transform_point3(origin),
+            edge_u: eu,
+            edge_v: ev,
+            n: orientation * cross / area,
+            pdf_area: (area > TINY).then(|| 1.0 / area),
+        }
+    }
+
+    /// The point at `u2` in edge coordinates.
+    fn sample(&self, u2: Vec2) -> Option<SurfacePoint> {
+        Some(SurfacePoint {
+            p: self.origin + u2.x * self.edge_u + u2.y * self.edge_v,
+            n: self.n,
+            pdf_area: self.pdf_area?,
+        })
+    }
 }
 
 /// A point sampled on an emitter's surface, with its unit outward normal and area density.
@@ -90,12 +139,29 @@ impl AreaLight {
                 Some(Distribution1D::new(&areas))
             }
         };
+        let fixed_quad = match (shape, placement) {
+            (
+                Shape::Quad {
+                    origin,
+                    edge_u,
+                    edge_v,
+                },
+                Placement::Static(world_from_object),
+            ) => Some(Box::new(WorldQuad::new(
+                world_from_object,
+                *origin,
+                *edge_u,
+                *edge_v,
+            ))),
+            _ => None,
+        };
         Ok(AreaLight {
             instance,
             emission,
             shape: shape.clone(),
             by_area,
             placement: Box::new(placement.clone()),
+            fixed_quad,
         })
     }
 
@@ -121,15 +187,19 @@ impl AreaLight {
 
     /// Samples a direction from `p_ref` towards this light at `time`.
     pub fn sample_li(&self, p_ref: Vec3, time: f32, u2: Vec2) -> Option<LightSample> {
-        let world_from_object = self.placement.at(time);
-        // Spheres that stay spheres: sample the cone they subtend.
-        if let Shape::Sphere { center, radius } = self.shape
-            && let Some((c_world, r_world)) = world_sphere(&world_from_object, center, radius)
-        {
-            return self.sample_cone(p_ref, c_world, r_world, u2);
-        }
-        // Everything else: a point by area, converted to solid angle.
-        let s = self.sample_area(&world_from_object, u2)?;
+        // Everything but cone-sampled spheres: a point by area, converted to solid angle.
+        let s = if let Some(quad) = &self.fixed_quad {
+            quad.sample(u2)?
+        } else {
+            let world_from_object = self.placement.at(time);
+            // Spheres that stay spheres: sample the cone they subtend.
+            if let Shape::Sphere { center, radius } = self.shape
+                && let Some((c_world, r_world)) = world_sphere(&world_from_object, center, radius)
+            {
+                return self.sample_cone(p_ref, c_world, r_world, u2);
+            }
+            self.sample_area(&world_from_object, u2)?
+        };
         let to_light = s.p - p_ref;
         let d2 = to_light.length_squared();
         if d2 <= TINY {
@@ -164,6 +234,9 @@ impl AreaLight {
         primitive: u32,
         time: f32,
     ) -> f32 {
+        if let Some(quad) = &self.fixed_quad {
+            return area_to_solid_angle(quad.pdf_area.unwrap_or(0.0), p_ref, p_light, n_light);
+        }
         let world_from_object = self.placement.at(time);
         if let Shape::Sphere { center, radius } = self.shape
             && let Some((c_world, r_world)) = world_sphere(&world_from_object, center, radius)
@@ -334,4 +407,65 @@ fn corners(mesh: &TriangleMesh, i: usize) -> Option<[Vec3; 3]> {
     mesh.triangles()
         .get(i)
         .map(|tri| tri.map(|v| positions[v as usize]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::{Mat4, Quat};
+    use proptest::prelude::*;
+
+    proptest! {
+        /// A fixed quad's world-space frame, made once, gives each sample and density the same
+        /// bits as carrying the quad to world space at every sample.
+        #[test]
+        fn a_fixed_quad_samples_as_the_quad_carried_each_time(
+            angles in proptest::array::uniform3(-3.0f32..3.0),
+            scale in proptest::array::uniform3(prop_oneof![-3.0f32..-0.1, 0.1f32..3.0]),
+            shift in proptest::array::uniform3(-5.0f32..5.0),
+            u in proptest::array::uniform2(0.0f32..1.0),
+        ) {
+            let m = Mat4::from_scale_rotation_translation(
+                Vec3::from(scale),
+                Quat::from_euler(glam::EulerRot::XYZ, angles[0], angles[1], angles[2]),
+                Vec3::from(shift),
+            );
+            let world_from_object = Transform::from_matrix(m).unwrap();
+            let shape = Shape::Quad {
+                origin: Vec3::new(-0.4, 0.2, 1.0),
+                edge_u: Vec3::new(0.8, 0.0, 0.1),
+                edge_v: Vec3::new(0.0, 0.7, -0.2),
+            };
+            let light =
+                AreaLight::new(&shape, &Placement::Static(world_from_object), Vec3::ONE, 0)
+                    .unwrap();
+            let fixed = light.fixed_quad.as_ref().unwrap().sample(Vec2::from(u)).unwrap();
+            let each = light.sample_area(&world_from_object, Vec2::from(u)).unwrap();
+            let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+            prop_assert_eq!(bits(fixed.p), bits(each.p));
+            prop_assert_eq!(bits(fixed.n), bits(each.n));
+            prop_assert_eq!(fixed.pdf_area.to_bits(), each.pdf_area.to_bits());
+            let pdf = light.pdf_area(&world_from_object, fixed.p, 0);
+            prop_assert_eq!(pdf.to_bits(), fixed.pdf_area.to_bits());
+        }
+    }
+
+    #[test]
+    fn only_fixed_quads_get_a_world_frame() {
+        let quad = Shape::Quad {
+            origin: Vec3::ZERO,
+            edge_u: Vec3::X,
+            edge_v: Vec3::Y,
+        };
+        let fixed = Placement::Static(Transform::identity());
+        let light = AreaLight::new(&quad, &fixed, Vec3::ONE, 0).unwrap();
+        let frame = light.fixed_quad.as_ref().unwrap();
+        assert_eq!((frame.n, frame.pdf_area), (Vec3::Z, Some(1.0)));
+        let sphere = Shape::Sphere {
+            center: Vec3::ZERO,
+            radius: 1.0,
+        };
+        let light = AreaLight::new(&sphere, &fixed, Vec3::ONE, 0).unwrap();
+        assert!(light.fixed_quad.is_none());
+    }
 }
