@@ -625,7 +625,6 @@ mod tests {
             let start = d.search_start(Vec2::new(ux, uy));
             prop_assert!(std::ptr::eq(start.guide_cell(), &row.cells[bucket(ux, w)]));
             let lo = row.cells[bucket(ux, w)].bin().guide as usize;
-
             prop_assert_eq!(start.row(), d.marginal.sample_continuous(uy).2);
             prop_assert_eq!(d.sample_with_value_in_row(Vec2::new(ux, uy), start.row()), (p, pdf, value));
             // A row past the last is the last, not a panic.
