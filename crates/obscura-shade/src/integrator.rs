@@ -320,12 +320,14 @@ impl PathIntegrator {
             .enumerate()
             .filter_map(|(slot, ray)| Some((slot, PathState::new(ray)?)))
             .collect();
+        // Every per-round list holds at most one entry per path: sized once, so that no
+        // round reallocates.
         let mut next_rays = Vec::with_capacity(live.len());
-        let mut pending: Vec<(usize, Shadow)> = Vec::new();
-        let mut shadow_rays = Vec::new();
+        let mut pending: Vec<(usize, Shadow)> = Vec::with_capacity(live.len());
+        let mut shadow_rays = Vec::with_capacity(live.len());
         let mut going_on = Vec::with_capacity(live.len());
-        let mut searches = Vec::new();
-        let mut ahead = Vec::new();
+        let mut searches = Vec::with_capacity(live.len());
+        let mut ahead = Vec::with_capacity(live.len());
         while !live.is_empty() {
             next_rays.clear();
             next_rays.extend(live.iter().map(|(_, path)| path.ray));

@@ -261,8 +261,9 @@ impl Scene {
                 })
             })
             .collect();
-        let mut waiting = Vec::new();
-        let mut batch = Vec::new();
+        // At most one entry per ray: sized once, so that pushing never reallocates.
+        let mut waiting = Vec::with_capacity(walks.len());
+        let mut batch = Vec::with_capacity(walks.len());
         for (k, w) in walks.iter_mut().enumerate() {
             if let Some(w) = w
                 && walk(w)
@@ -303,8 +304,8 @@ impl Scene {
         };
         let flat_lane = self.items.iter().position(|i| matches!(i, Item::Flat));
         let mut out = Vec::with_capacity(rays.len());
-        let mut waiting = Vec::new();
-        let mut batch = Vec::new();
+        let mut waiting = Vec::with_capacity(rays.len());
+        let mut batch = Vec::with_capacity(rays.len());
         for ray in rays {
             let Some(r) = PlainRay::new(ray) else {
                 out.push(false);

@@ -159,7 +159,9 @@ impl WideBvh {
             for slot in slots.by_ref() {
                 match Q::start(self, &rays[slot]) {
                     Ok(q) => {
-                        let mut stack = stacks.pop().unwrap_or_default();
+                        let mut stack = stacks
+                            .pop()
+                            .unwrap_or_else(|| Vec::with_capacity(STACK_CAPACITY));
                         stack.clear();
                         return Some((q, slot, stack));
                     }
@@ -199,6 +201,11 @@ impl WideBvh {
         }
     }
 }
+
+/// The entries a batch's traversal stack is made with: more than a query on an eight-wide
+/// tree of a million triangles stacks (about seven levels, at most seven children each), so
+/// that a stack does not grow by reallocation while a batch runs.
+const STACK_CAPACITY: usize = 64;
 
 /// Asks for the lines of the node or packet `r` names.
 #[inline(always)]
