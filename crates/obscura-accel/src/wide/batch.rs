@@ -13,6 +13,7 @@
 //! gives for that ray.
 
 use super::layout::{LEAF, Node, Packet};
+use super::stack::Stack;
 use super::traverse::{Any, Closest, Step};
 use super::{WideBvh, WideHit};
 use crate::simd::prefetch;
@@ -40,7 +41,7 @@ pub(super) trait InTurns: Sized {
     /// What the query answers for a ray.
     type Answer;
     /// An entry of its traversal stack.
-    type Entry;
+    type Entry: Copy + Default;
     /// The query of a ray with `t_min >= 0` from the tree's root.
     fn new(root: u32, r: &BatchRay) -> Self;
     /// The ray's query, or its answer at once from the one-ray query: a ray that may start
@@ -59,7 +60,7 @@ pub(super) trait InTurns: Sized {
         &mut self,
         nodes: &[Node],
         packets: &[Packet],
-        stack: &mut Vec<Self::Entry>,
+        stack: &mut Stack<Self::Entry>,
     ) -> Option<Self::Answer>;
     /// The node or packet the query visits next.
     fn at(&self) -> u32;
@@ -78,7 +79,7 @@ impl InTurns for Closest<false> {
         &mut self,
         nodes: &[Node],
         packets: &[Packet],
-        stack: &mut Vec<Self::Entry>,
+        stack: &mut Stack<Self::Entry>,
     ) -> Option<Self::Answer> {
         (!self.step::<false>(nodes, packets, stack, &mut 0)).then(|| self.hit(packets))
     }
@@ -100,7 +101,7 @@ impl InTurns for Any<false> {
         &mut self,
         nodes: &[Node],
         packets: &[Packet],
-        stack: &mut Vec<Self::Entry>,
+        stack: &mut Stack<Self::Entry>,
     ) -> Option<Self::Answer> {
         match self.step::<false>(nodes, packets, stack, &mut 0) {
             Step::Next => None,
@@ -151,17 +152,15 @@ impl WideBvh {
     #[inline(always)]
     pub(super) fn run<Q: InTurns>(&self, rays: &[BatchRay], out: &mut [Q::Answer]) {
         let (nodes, packets) = (&*self.nodes, &*self.packets);
-        let mut flights: Vec<(Q, usize, Vec<Q::Entry>)> = Vec::with_capacity(LANES);
-        let mut stacks: Vec<Vec<Q::Entry>> = Vec::with_capacity(LANES);
+        let mut flights: Vec<Flight<Q>> = Vec::with_capacity(LANES);
+        let mut stacks: Vec<Box<Stack<Q::Entry>>> = Vec::with_capacity(LANES);
         let mut slots = 0..rays.len().min(out.len());
         // The next ray that needs a traversal, answering the others on the way.
-        let mut next = |stacks: &mut Vec<Vec<Q::Entry>>, out: &mut [Q::Answer]| {
+        let mut next = |stacks: &mut Vec<Box<Stack<Q::Entry>>>, out: &mut [Q::Answer]| {
             for slot in slots.by_ref() {
                 match Q::start(self, &rays[slot]) {
                     Ok(q) => {
-                        let mut stack = stacks
-                            .pop()
-                            .unwrap_or_else(|| Vec::with_capacity(STACK_CAPACITY));
+                        let mut stack = stacks.pop().unwrap_or_default();
                         stack.clear();
                         return Some((q, slot, stack));
                     }
@@ -202,10 +201,9 @@ impl WideBvh {
     }
 }
 
-/// The entries a batch's traversal stack is made with: more than a query on an eight-wide
-/// tree of a million triangles stacks (about seven levels, at most seven children each), so
-/// that a stack does not grow by reallocation while a batch runs.
-const STACK_CAPACITY: usize = 64;
+/// A ray's query in flight: the query, the ray's slot, and its stack (boxed, so that handing
+/// a lane to the next ray moves a pointer, not the stack).
+type Flight<Q> = (Q, usize, Box<Stack<<Q as InTurns>::Entry>>);
 
 /// Asks for the lines of the node or packet `r` names.
 #[inline(always)]

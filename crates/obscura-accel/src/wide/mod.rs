@@ -25,7 +25,7 @@
 //!
 //! The files: `layout.rs` (nodes and packets), `collapse.rs` (the build), `ray.rs` (the slab
 //! and triangle tests), `traverse.rs` (the queries, one step at a time), `batch.rs` (batches
-//! in turns), `boxset.rs` (a top level of few boxes).
+//! in turns), `boxset.rs` (a top level of few boxes), `stack.rs` (the traversal stack).
 //!
 //! Everything here is safe Rust: the lanes are glam's `Vec4` (an SSE register on x86-64) or
 //! arrays the compiler vectorises; the one prefetch instruction is in the crate's `simd`
@@ -36,6 +36,7 @@ mod boxset;
 mod collapse;
 mod layout;
 mod ray;
+mod stack;
 mod traverse;
 
 pub(crate) use batch::BatchRay;

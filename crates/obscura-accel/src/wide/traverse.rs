@@ -2,30 +2,34 @@
 
 use super::layout::{ARITY, EMPTY, LEAF, Node, Packet};
 use super::ray::{Prepared, by_entry};
+use super::stack::Stack;
 use super::{WideBvh, WideHit};
 use crate::geom::TriangleHit;
 use glam::{Vec3, Vec3A, Vec4};
 use std::cell::Cell;
 
+/// A thread's kept stack: taken for a query and put back after it.
+type Kept<T> = Cell<Option<Box<Stack<T>>>>;
+
 thread_local! {
     /// Each thread's traversal stacks, kept between queries so a query neither allocates nor
-    /// clears a fixed array.
-    static CLOSEST_STACK: Cell<Vec<(u32, f32)>> = const { Cell::new(Vec::new()) };
-    static ANY_STACK: Cell<Vec<u32>> = const { Cell::new(Vec::new()) };
+    /// fills a fixed array.
+    static CLOSEST_STACK: Kept<(u32, f32)> = const { Cell::new(None) };
+    static ANY_STACK: Kept<u32> = const { Cell::new(None) };
 }
 
 /// Runs `query` with this thread's (emptied) stack from `key`. The stack is taken, not
 /// borrowed, so a nested query (none today) would simply get a fresh one.
 #[inline(always)]
-fn with_stack<T, R>(
-    key: &'static std::thread::LocalKey<Cell<Vec<T>>>,
-    query: impl FnOnce(&mut Vec<T>) -> R,
+fn with_stack<T: Copy + Default, R>(
+    key: &'static std::thread::LocalKey<Kept<T>>,
+    query: impl FnOnce(&mut Stack<T>) -> R,
 ) -> R {
     key.with(|cell| {
-        let mut stack = cell.take();
+        let mut stack = cell.take().unwrap_or_default();
         stack.clear();
         let result = query(&mut stack);
-        cell.set(stack);
+        cell.set(Some(stack));
         result
     })
 }
@@ -58,7 +62,7 @@ impl WideBvh {
     #[inline(always)]
     fn closest_with<const SLACK: bool>(
         &self,
-        stack: &mut Vec<(u32, f32)>,
+        stack: &mut Stack<(u32, f32)>,
         o: Vec3A,
         d: Vec3A,
         t_min: f32,
@@ -75,7 +79,7 @@ impl WideBvh {
     #[inline(always)]
     fn any_with<const SLACK: bool>(
         &self,
-        stack: &mut Vec<u32>,
+        stack: &mut Stack<u32>,
         o: Vec3A,
         d: Vec3A,
         t_min: f32,
@@ -130,7 +134,7 @@ impl<const SLACK: bool> Closest<SLACK> {
         &mut self,
         nodes: &[Node],
         packets: &[Packet],
-        stack: &mut Vec<(u32, f32)>,
+        stack: &mut Stack<(u32, f32)>,
         warm: &mut u32,
     ) -> bool {
         let current = self.current;
@@ -256,7 +260,7 @@ impl<const SLACK: bool> Any<SLACK> {
         &mut self,
         nodes: &[Node],
         packets: &[Packet],
-        stack: &mut Vec<u32>,
+        stack: &mut Stack<u32>,
         warm: &mut u32,
     ) -> Step {
         let current = self.current;
