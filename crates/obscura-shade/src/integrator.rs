@@ -314,12 +314,14 @@ impl PathIntegrator {
                 .collect();
         }
         let mut out = vec![(Vec3::ZERO, false); rays.len().min(dims.len())];
-        let mut live: Vec<(usize, PathState)> = rays
-            .iter()
-            .take(dims.len())
-            .enumerate()
-            .filter_map(|(slot, ray)| Some((slot, PathState::new(ray)?)))
-            .collect();
+        // Sized for every ray (a filtered iterator would grow it by doubling).
+        let mut live: Vec<(usize, PathState)> = Vec::with_capacity(out.len());
+        live.extend(
+            rays.iter()
+                .take(dims.len())
+                .enumerate()
+                .filter_map(|(slot, ray)| Some((slot, PathState::new(ray)?))),
+        );
         // Every per-round list holds at most one entry per path: sized once, so that no
         // round reallocates.
         let mut next_rays = Vec::with_capacity(live.len());
