@@ -29,9 +29,21 @@ pub struct AreaLight {
     /// Boxed: transforms are large, and [`Light`](super::Light)'s variants should stay close
     /// in size.
     placement: Box<Placement>,
-    /// A quad that does not move, in world space once for all its samples (every light sample
-    /// would otherwise carry its corner and edges there and find its area again).
-    fixed_quad: Option<Box<WorldQuad>>,
+    /// A quad or sphere that does not move, placed in world space once for all its samples
+    /// (every light sample would otherwise carry it there again: a quad's corner, edges and
+    /// area, a sphere's centre and radius after checking that its placement is a similarity).
+    fixed: Option<Box<Placed>>,
+}
+
+/// An emitter that does not move, placed in world space when the light is made.
+#[derive(Debug, Clone)]
+enum Placed {
+    Quad(WorldQuad),
+    /// A sphere placed by a similarity, sampled by the cone it subtends.
+    Sphere {
+        center: Vec3,
+        radius: f32,
+    },
 }
 
 /// A quad in world space: what sampling it by area and its density need.
@@ -139,7 +151,7 @@ impl AreaLight {
                 Some(Distribution1D::new(&areas))
             }
         };
-        let fixed_quad = match (shape, placement) {
+        let fixed = match (shape, placement) {
             (
                 Shape::Quad {
                     origin,
@@ -147,12 +159,16 @@ impl AreaLight {
                     edge_v,
                 },
                 Placement::Static(world_from_object),
-            ) => Some(Box::new(WorldQuad::new(
+            ) => Some(Placed::Quad(WorldQuad::new(
                 world_from_object,
                 *origin,
                 *edge_u,
                 *edge_v,
             ))),
+            (Shape::Sphere { center, radius }, Placement::Static(world_from_object)) => {
+                world_sphere(world_from_object, *center, *radius)
+                    .map(|(center, radius)| Placed::Sphere { center, radius })
+            }
             _ => None,
         };
         Ok(AreaLight {
@@ -161,7 +177,7 @@ impl AreaLight {
             shape: shape.clone(),
             by_area,
             placement: Box::new(placement.clone()),
-            fixed_quad,
+            fixed: fixed.map(Box::new),
         })
     }
 
@@ -188,17 +204,22 @@ impl AreaLight {
     /// Samples a direction from `p_ref` towards this light at `time`.
     pub fn sample_li(&self, p_ref: Vec3, time: f32, u2: Vec2) -> Option<LightSample> {
         // Everything but cone-sampled spheres: a point by area, converted to solid angle.
-        let s = if let Some(quad) = &self.fixed_quad {
-            quad.sample(u2)?
-        } else {
-            let world_from_object = self.placement.at(time);
-            // Spheres that stay spheres: sample the cone they subtend.
-            if let Shape::Sphere { center, radius } = self.shape
-                && let Some((c_world, r_world)) = world_sphere(&world_from_object, center, radius)
-            {
-                return self.sample_cone(p_ref, c_world, r_world, u2);
+        let s = match self.fixed.as_deref() {
+            Some(Placed::Quad(quad)) => quad.sample(u2)?,
+            Some(&Placed::Sphere { center, radius }) => {
+                return self.sample_cone(p_ref, center, radius, u2);
             }
-            self.sample_area(&world_from_object, u2)?
+            None => {
+                let world_from_object = self.placement.at(time);
+                // Spheres that stay spheres: sample the cone they subtend.
+                if let Shape::Sphere { center, radius } = self.shape
+                    && let Some((c_world, r_world)) =
+                        world_sphere(&world_from_object, center, radius)
+                {
+                    return self.sample_cone(p_ref, c_world, r_world, u2);
+                }
+                self.sample_area(&world_from_object, u2)?
+            }
         };
         let to_light = s.p - p_ref;
         let d2 = to_light.length_squared();
@@ -234,20 +255,20 @@ impl AreaLight {
         primitive: u32,
         time: f32,
     ) -> f32 {
-        if let Some(quad) = &self.fixed_quad {
-            return area_to_solid_angle(quad.pdf_area.unwrap_or(0.0), p_ref, p_light, n_light);
+        match self.fixed.as_deref() {
+            Some(Placed::Quad(quad)) => {
+                return area_to_solid_angle(quad.pdf_area.unwrap_or(0.0), p_ref, p_light, n_light);
+            }
+            Some(&Placed::Sphere { center, radius }) => {
+                return sphere_pdf(center, radius, p_ref, p_light, n_light);
+            }
+            None => {}
         }
         let world_from_object = self.placement.at(time);
         if let Shape::Sphere { center, radius } = self.shape
             && let Some((c_world, r_world)) = world_sphere(&world_from_object, center, radius)
         {
-            let d2 = (c_world - p_ref).length_squared();
-            let r2 = r_world * r_world;
-            if d2 > r2 {
-                return cone_pdf(r2 / d2);
-            }
-            // Inside the sphere: sampled by area (and nothing is emitted inwards).
-            return area_to_solid_angle(1.0 / (4.0 * PI * r2), p_ref, p_light, n_light);
+            return sphere_pdf(c_world, r_world, p_ref, p_light, n_light);
         }
         let pdf_area = self.pdf_area(&world_from_object, p_light, primitive);
         area_to_solid_angle(pdf_area, p_ref, p_light, n_light)
@@ -387,6 +408,19 @@ impl AreaLight {
     }
 }
 
+/// The solid-angle density of a light sample from `p_ref` at `p_light` (normal `n_light`) on
+/// the world-space sphere of centre `c` and radius `r`: the cone's from outside, the area
+/// density from inside (where nothing is emitted inwards).
+fn sphere_pdf(c: Vec3, r: f32, p_ref: Vec3, p_light: Vec3, n_light: Vec3) -> f32 {
+    let d2 = (c - p_ref).length_squared();
+    let r2 = r * r;
+    if d2 > r2 {
+        cone_pdf(r2 / d2)
+    } else {
+        area_to_solid_angle(1.0 / (4.0 * PI * r2), p_ref, p_light, n_light)
+    }
+}
+
 /// The object-space corners of triangle `i` of `mesh`; `None` past the last triangle.
 fn corners(mesh: &TriangleMesh, i: usize) -> Option<[Vec3; 3]> {
     let positions = mesh.positions();
@@ -424,7 +458,10 @@ mod tests {
             let light =
                 AreaLight::new(&shape, &Placement::Static(world_from_object), Vec3::ONE, 0)
                     .unwrap();
-            let fixed = light.fixed_quad.as_ref().unwrap().sample(Vec2::from(u)).unwrap();
+            let Some(Placed::Quad(quad)) = light.fixed.as_deref() else {
+                panic!("a static quad light keeps its placed quad");
+            };
+            let fixed = quad.sample(Vec2::from(u)).unwrap();
             let m = world_from_object.matrix();
             let (eu, ev) = (m.transform_vector3(edge_u), m.transform_vector3(edge_v));
             let cross = eu.cross(ev);
@@ -441,8 +478,77 @@ mod tests {
         }
     }
 
+    proptest! {
+        /// A fixed sphere, placed once, samples and weighs as the sphere placed at the sample:
+        /// the centre carried to world space and the radius times the map's scale (written out
+        /// here as `world_sphere` computes them), then the cone from `p_ref`, to the bit.
+        #[test]
+        fn a_fixed_sphere_samples_as_the_sphere_placed_each_time(
+            angles in proptest::array::uniform3(-3.0f32..3.0),
+            scale in prop_oneof![-3.0f32..-0.1, 0.1f32..3.0],
+            shift in proptest::array::uniform3(-5.0f32..5.0),
+            p_ref in proptest::array::uniform3(-20.0f32..20.0),
+            u in proptest::array::uniform2(0.0f32..1.0),
+        ) {
+            let m = Mat4::from_scale_rotation_translation(
+                Vec3::splat(scale),
+                Quat::from_euler(glam::EulerRot::XYZ, angles[0], angles[1], angles[2]),
+                Vec3::from(shift),
+            );
+            let world_from_object = Transform::from_matrix(m).unwrap();
+            let (center, radius) = (Vec3::new(0.3, -0.2, 0.5), 0.7);
+            let shape = Shape::Sphere { center, radius };
+            let light =
+                AreaLight::new(&shape, &Placement::Static(world_from_object), Vec3::ONE, 0)
+                    .unwrap();
+            let placed = matches!(light.fixed.as_deref(), Some(Placed::Sphere { .. }));
+            prop_assert!(placed, "a static sphere is placed once");
+            let m = world_from_object.matrix();
+            let c_world = m.transform_point3(center);
+            let r_world = radius * Mat3::from_mat4(m).x_axis.length();
+            let (p_ref, u) = (Vec3::from(p_ref), Vec2::from(u));
+            let kept = light.sample_li(p_ref, 0.0, u);
+            let each = light.sample_cone(p_ref, c_world, r_world, u);
+            let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+            match (kept, each) {
+                (Some(a), Some(b)) => {
+                    prop_assert_eq!(bits(a.wi), bits(b.wi));
+                    prop_assert_eq!(a.pdf.to_bits(), b.pdf.to_bits());
+                    let (pa, pb) = (a.p_light.unwrap(), b.p_light.unwrap());
+                    prop_assert_eq!(bits(pa), bits(pb));
+                    let n = (pa - c_world) / r_world;
+                    prop_assert_eq!(
+                        light.pdf_li(p_ref, pa, n, 0, 0.0).to_bits(),
+                        sphere_pdf(c_world, r_world, p_ref, pa, n).to_bits()
+                    );
+                }
+                (None, None) => {}
+                (a, b) => prop_assert!(false, "kept {:?} against placed {:?}", a.is_some(), b.is_some()),
+            }
+        }
+    }
+
+    /// The sphere's density by hand: from 5 away, a sphere of radius 3 subtends a cone with
+    /// `sin^2 = 9 / 25`, `cos = 4 / 5`, solid angle `2 pi (1 - 4/5)`, so a uniform sample's
+    /// density is `1 / (0.4 pi)`; from inside, the area density `1 / (4 pi r^2)` turned into
+    /// solid angle.
     #[test]
-    fn only_fixed_quads_get_a_world_frame() {
+    fn sphere_pdf_by_hand() {
+        let pdf = sphere_pdf(
+            Vec3::ZERO,
+            3.0,
+            Vec3::new(0.0, 0.0, 5.0),
+            Vec3::Z * 3.0,
+            Vec3::Z,
+        );
+        assert!((pdf - 1.0 / (0.4 * PI)).abs() < 1e-5 * pdf, "{pdf}");
+        // From the centre, the point 3 away along +z seen head on: (1 / (36 pi)) * 9 / 1.
+        let inside = sphere_pdf(Vec3::ZERO, 3.0, Vec3::ZERO, Vec3::Z * 3.0, Vec3::Z);
+        assert!((inside - 1.0 / (4.0 * PI)).abs() < 1e-6, "{inside}");
+    }
+
+    #[test]
+    fn only_static_quads_and_spheres_are_placed_once() {
         let quad = Shape::Quad {
             origin: Vec3::ZERO,
             edge_u: Vec3::X,
@@ -450,13 +556,39 @@ mod tests {
         };
         let fixed = Placement::Static(Transform::identity());
         let light = AreaLight::new(&quad, &fixed, Vec3::ONE, 0).unwrap();
-        let frame = light.fixed_quad.as_ref().unwrap();
+        let Some(Placed::Quad(frame)) = light.fixed.as_deref() else {
+            panic!("a static quad is placed once");
+        };
         assert_eq!((frame.n, frame.pdf_area), (Vec3::Z, Some(1.0)));
         let sphere = Shape::Sphere {
-            center: Vec3::ZERO,
-            radius: 1.0,
+            center: Vec3::new(1.0, 0.0, 0.0),
+            radius: 0.5,
         };
-        let light = AreaLight::new(&sphere, &fixed, Vec3::ONE, 0).unwrap();
-        assert!(light.fixed_quad.is_none());
+        // Scaled by 2 and moved by (0, 3, 0): centre (2, 3, 0), radius 1.
+        let scale_and_move = Transform::from_matrix(Mat4::from_scale_rotation_translation(
+            Vec3::splat(2.0),
+            Quat::IDENTITY,
+            Vec3::new(0.0, 3.0, 0.0),
+        ))
+        .unwrap();
+        let scaled = Placement::Static(scale_and_move);
+        let light = AreaLight::new(&sphere, &scaled, Vec3::ONE, 0).unwrap();
+        let Some(&Placed::Sphere { center, radius }) = light.fixed.as_deref() else {
+            panic!("a static sphere placed by a similarity is placed once");
+        };
+        assert_eq!((center, radius), (Vec3::new(2.0, 3.0, 0.0), 1.0));
+        // Squashed into an ellipsoid: sampled by area at each sample, nothing kept.
+        let squashed = Placement::Static(
+            Transform::from_matrix(Mat4::from_scale(Vec3::new(1.0, 2.0, 1.0))).unwrap(),
+        );
+        let light = AreaLight::new(&sphere, &squashed, Vec3::ONE, 0).unwrap();
+        assert!(light.fixed.is_none());
+        // Moving: placed at each sample's time.
+        let moving = Placement::Moving(
+            obscura_space::AnimatedTransform::new(Transform::identity(), 0.0, scale_and_move, 1.0)
+                .unwrap(),
+        );
+        let light = AreaLight::new(&sphere, &moving, Vec3::ONE, 0).unwrap();
+        assert!(light.fixed.is_none());
     }
 }
