@@ -23,12 +23,16 @@ pub(super) const FAR_SCALE: f32 = 1.0 + 2.0 * gamma(4);
 /// `SLACK`: far distances get [`SLAB_SLACK`] after the fact (a query with `t_min < 0`);
 /// otherwise the far planes' reciprocals carry [`FAR_SCALE`]. Which one a query takes is
 /// decided once, so the traversal of each has no test for it per node.
+///
+/// Everything a node's test reads is kept splatted, one value in every lane: a batch keeps
+/// several queries and reloads a query's ray at each of its steps, and a splatted vector is
+/// one load where a scalar is a load and a shuffle.
 pub(super) struct Prepared<const SLACK: bool> {
     o: [Vec4; 3],
     d: [Vec4; 3],
-    inv: [f32; 3],
+    inv: [Vec4; 3],
     /// The far planes' reciprocals: `inv` times [`FAR_SCALE`], or `inv` itself with `SLACK`.
-    inv_far: [f32; 3],
+    inv_far: [Vec4; 3],
     /// 1 where the direction is negative (the box's max plane is met first), else 0.
     near: [usize; 3],
 }
@@ -48,18 +52,16 @@ impl<const SLACK: bool> Prepared<SLACK> {
         Prepared {
             o: [Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z)],
             d: [Vec4::splat(d.x), Vec4::splat(d.y), Vec4::splat(d.z)],
-            inv,
-            inv_far: inv_far.to_array(),
+            inv: inv.map(Vec4::splat),
+            inv_far: inv_far.to_array().map(Vec4::splat),
             near: inv.map(|i| usize::from(i < 0.0)),
         }
     }
 
     /// The entry distance of each of the node's first `N` children's boxes and the mask of
     /// those the ray enters within `[t_min, t_max]` (`N` a multiple of four: eight for a BVH
-    /// node, four for a top level of few boxes). Written over plain arrays, which the compiler
-    /// vectorises: one SSE register per four lanes on baseline x86-64 (one AVX register for
-    /// eight when built for a CPU that has it). The `if`s are
-    /// `maxps`/`minps` exactly, NaN operands included.
+    /// node, four for a top level of few boxes), four lanes to a register. `Vec4::max(a, b)`
+    /// and `min` are `maxps`/`minps` exactly (`a > b ? a : b`), NaN operands included.
     #[inline(always)]
     pub(super) fn slabs<const N: usize>(
         &self,
@@ -68,44 +70,27 @@ impl<const SLACK: bool> Prepared<SLACK> {
         t_max: f32,
     ) -> ([f32; N], u32) {
         const { assert!(N.is_multiple_of(WIDTH) && N <= ARITY) };
-        #[inline(always)]
-        fn max(a: f32, b: f32) -> f32 {
-            if a > b { a } else { b }
-        }
-        #[inline(always)]
-        fn min(a: f32, b: f32) -> f32 {
-            if a < b { a } else { b }
-        }
-        let plane = |i: usize| -> &[f32; N] {
-            let lanes: &[f32; ARITY] = bytemuck::cast_ref(&node.bounds[i]);
-            lanes.first_chunk().expect("N <= ARITY")
-        };
         let (nx, ny, nz) = (self.near[0] & 1, self.near[1] & 1, self.near[2] & 1);
-        let (near_x, far_x) = (plane(nx), plane(nx ^ 1));
-        let (near_y, far_y) = (plane(2 + ny), plane(2 + (ny ^ 1)));
-        let (near_z, far_z) = (plane(4 + nz), plane(4 + (nz ^ 1)));
-        let (o, inv, inv_far) = (self.o.map(|v| v.x), self.inv, self.inv_far);
+        let ([ox, oy, oz], [ix, iy, iz], [fx, fy, fz]) = (&self.o, &self.inv, &self.inv_far);
+        let (t_min, t_max) = (Vec4::splat(t_min), Vec4::splat(t_max));
         let mut t_near = [0.0; N];
-        let mut t_far = [0.0; N];
-        for lane in 0..N {
-            let tnx = (near_x[lane] - o[0]) * inv[0];
-            let tfx = (far_x[lane] - o[0]) * inv_far[0];
-            let tny = (near_y[lane] - o[1]) * inv[1];
-            let tfy = (far_y[lane] - o[1]) * inv_far[1];
-            let tnz = (near_z[lane] - o[2]) * inv[2];
-            let tfz = (far_z[lane] - o[2]) * inv_far[2];
-            t_near[lane] = max(max(tnx, tny), max(tnz, t_min));
-            let t = min(min(tfx, tfy), tfz);
+        let mut mask = 0;
+        for h in 0..N / WIDTH {
+            let plane = |i: usize| node.bounds[i][h];
+            let tnx = (plane(nx) - *ox) * *ix;
+            let tfx = (plane(nx ^ 1) - *ox) * *fx;
+            let tny = (plane(2 + ny) - *oy) * *iy;
+            let tfy = (plane(2 + (ny ^ 1)) - *oy) * *fy;
+            let tnz = (plane(4 + nz) - *oz) * *iz;
+            let tfz = (plane(4 + (nz ^ 1)) - *oz) * *fz;
+            let near = tnx.max(tny).max(tnz.max(t_min));
+            let t = tfx.min(tfy).min(tfz);
             // An unused lane's near distance is +inf and its far distance -inf, so it is
             // never entered. The slack makes -inf NaN; `t_max` goes first so that `minps`
             // returns its second operand, NaN, which no entry distance is below.
-            t_far[lane] = min(t_max, if SLACK { t + t.abs() * SLAB_SLACK } else { t });
-        }
-        // The mask four lanes at a time: the compiler does not find `movmskps` in the loop.
-        let mut mask = 0;
-        for h in 0..N / WIDTH {
-            let near = Vec4::from_slice(&t_near[WIDTH * h..]);
-            mask |= near.cmple(Vec4::from_slice(&t_far[WIDTH * h..])).bitmask() << (WIDTH * h);
+            let far = t_max.min(if SLACK { t + t.abs() * SLAB_SLACK } else { t });
+            near.write_to_slice(&mut t_near[WIDTH * h..]);
+            mask |= near.cmple(far).bitmask() << (WIDTH * h);
         }
         (t_near, mask)
     }
