@@ -3,8 +3,8 @@
 //! obvhs builds a binary BVH (PLOC, then reinsertion, with the [`BvhBuildParams`] preset); it is
 //! collapsed here into nodes of up to eight children whose boxes sit in structure-of-arrays
 //! form, one lane per child, so one ray tests eight boxes in two registers' worth of SSE
-//! instructions (the test is written over plain eight-lane arrays, which the compiler
-//! vectorises; a build for an AVX CPU gets one register). Leaves are *packets* of up to four
+//! instructions (written on glam's `Vec4`, four lanes to a register, with the ray's values
+//! kept splatted so a batch reloads them without shuffles). Leaves are *packets* of up to four
 //! triangles (their first vertices and edges, again one lane per triangle) tested together by
 //! a four-wide Möller–Trumbore. Which binary nodes become a wide node's children and which
 //! subtrees become packets is chosen by a surface-area dynamic programme over the whole binary
@@ -27,9 +27,8 @@
 //! and triangle tests), `traverse.rs` (the queries, one step at a time), `batch.rs` (batches
 //! in turns), `boxset.rs` (a top level of few boxes), `stack.rs` (the traversal stack).
 //!
-//! Everything here is safe Rust: the lanes are glam's `Vec4` (an SSE register on x86-64) or
-//! arrays the compiler vectorises; the one prefetch instruction is in the crate's `simd`
-//! module.
+//! Everything here is safe Rust: the lanes are glam's `Vec4` (an SSE register on x86-64); the
+//! one prefetch instruction is in the crate's `simd` module.
 
 mod batch;
 mod boxset;
