@@ -153,25 +153,20 @@ impl WideBvh {
     pub(super) fn run<Q: InTurns>(&self, rays: &[BatchRay], out: &mut [Q::Answer]) {
         let (nodes, packets) = (&*self.nodes, &*self.packets);
         let mut flights: Vec<Flight<Q>> = Vec::with_capacity(LANES);
-        let mut stacks: Vec<Box<Stack<Q::Entry>>> = Vec::with_capacity(LANES);
         let mut slots = 0..rays.len().min(out.len());
         // The next ray that needs a traversal, answering the others on the way.
-        let mut next = |stacks: &mut Vec<Box<Stack<Q::Entry>>>, out: &mut [Q::Answer]| {
+        let mut next = |out: &mut [Q::Answer]| {
             for slot in slots.by_ref() {
                 match Q::start(self, &rays[slot]) {
-                    Ok(q) => {
-                        let mut stack = stacks.pop().unwrap_or_default();
-                        stack.clear();
-                        return Some((q, slot, stack));
-                    }
+                    Ok(q) => return Some((q, slot)),
                     Err(answer) => out[slot] = answer,
                 }
             }
             None
         };
         while flights.len() < LANES {
-            match next(&mut stacks, out) {
-                Some(flight) => flights.push(flight),
+            match next(out) {
+                Some((q, slot)) => flights.push((q, slot, Stack::new())),
                 None => break,
             }
         }
@@ -185,15 +180,15 @@ impl WideBvh {
                     continue;
                 };
                 out[*slot] = answer;
-                match next(&mut stacks, out) {
-                    Some(fresh) => {
-                        let (_, _, stack) = std::mem::replace(&mut flights[i], fresh);
-                        stacks.push(stack);
+                // The lane's next ray takes over its query and its (emptied) stack in place.
+                match next(out) {
+                    Some((fresh, fresh_slot)) => {
+                        (*q, *slot) = (fresh, fresh_slot);
+                        stack.clear();
                         i += 1;
                     }
                     None => {
-                        let (_, _, stack) = flights.swap_remove(i);
-                        stacks.push(stack);
+                        flights.swap_remove(i);
                     }
                 }
             }
@@ -201,9 +196,8 @@ impl WideBvh {
     }
 }
 
-/// A ray's query in flight: the query, the ray's slot, and its stack (boxed, so that handing
-/// a lane to the next ray moves a pointer, not the stack).
-type Flight<Q> = (Q, usize, Box<Stack<<Q as InTurns>::Entry>>);
+/// A ray's query in flight: the query, the ray's slot, and its stack.
+type Flight<Q> = (Q, usize, Stack<<Q as InTurns>::Entry>);
 
 /// Asks for the lines of the node or packet `r` names.
 #[inline(always)]
