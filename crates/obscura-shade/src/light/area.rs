@@ -435,6 +435,16 @@ mod tests {
     use glam::{Mat4, Quat};
     use proptest::prelude::*;
 
+    /// Scaled by `scale`, turned by the Euler angles `angles` (XYZ) and moved by `shift`.
+    fn placement(scale: Vec3, angles: [f32; 3], shift: [f32; 3]) -> Transform<World, Object> {
+        let m = Mat4::from_scale_rotation_translation(
+            scale,
+            Quat::from_euler(glam::EulerRot::XYZ, angles[0], angles[1], angles[2]),
+            Vec3::from(shift),
+        );
+        Transform::from_matrix(m).unwrap()
+    }
+
     proptest! {
         /// A fixed quad's world-space frame, made once, gives each sample and density the bits
         /// of the quad carried to world space at that sample, written out here as the light
@@ -446,12 +456,7 @@ mod tests {
             shift in proptest::array::uniform3(-5.0f32..5.0),
             u in proptest::array::uniform2(0.0f32..1.0),
         ) {
-            let m = Mat4::from_scale_rotation_translation(
-                Vec3::from(scale),
-                Quat::from_euler(glam::EulerRot::XYZ, angles[0], angles[1], angles[2]),
-                Vec3::from(shift),
-            );
-            let world_from_object = Transform::from_matrix(m).unwrap();
+            let world_from_object = placement(Vec3::from(scale), angles, shift);
             let (origin, edge_u, edge_v) =
                 (Vec3::new(-0.4, 0.2, 1.0), Vec3::new(0.8, 0.0, 0.1), Vec3::new(0.0, 0.7, -0.2));
             let shape = Shape::Quad { origin, edge_u, edge_v };
@@ -490,12 +495,7 @@ mod tests {
             p_ref in proptest::array::uniform3(-20.0f32..20.0),
             u in proptest::array::uniform2(0.0f32..1.0),
         ) {
-            let m = Mat4::from_scale_rotation_translation(
-                Vec3::splat(scale),
-                Quat::from_euler(glam::EulerRot::XYZ, angles[0], angles[1], angles[2]),
-                Vec3::from(shift),
-            );
-            let world_from_object = Transform::from_matrix(m).unwrap();
+            let world_from_object = placement(Vec3::splat(scale), angles, shift);
             let (center, radius) = (Vec3::new(0.3, -0.2, 0.5), 0.7);
             let shape = Shape::Sphere { center, radius };
             let light =
