@@ -60,8 +60,10 @@ impl<const SLACK: bool> Prepared<SLACK> {
 
     /// The entry distance of each of the node's first `N` children's boxes and the mask of
     /// those the ray enters within `[t_min, t_max]` (`N` a multiple of four: eight for a BVH
-    /// node, four for a top level of few boxes), four lanes to a register. `Vec4::max(a, b)`
-    /// and `min` are `maxps`/`minps` exactly (`a > b ? a : b`), NaN operands included.
+    /// node, four for a top level of few boxes), four lanes to a register. On x86-64
+    /// `Vec4::max(a, b)` and `min` are `maxps`/`minps` (`a > b ? a : b`, the second operand
+    /// when either is NaN), as were the scalar `if`s this replaced; the one NaN the test can
+    /// make (an unused lane's far distance with the slack, below) stays NaN on every target.
     #[inline(always)]
     pub(super) fn slabs<const N: usize>(
         &self,
