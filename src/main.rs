@@ -497,7 +497,7 @@ fn run_render(args: RenderArgs) -> Result<ExitCode, RenderError> {
     let threads_used =
         threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
     let mut summary = format!(
-        "rendered {} -> {}: {w}x{h}, {spp} spp{}, {} integrator, {:.2} M samples in {:.2} s ({:.2} M camera rays/s, {threads_used} threads)",
+        "rendered {} -> {}: {w}x{h}, {spp} spp{}, {} integrator, {:.2} M samples in {:.3} s ({:.2} M camera rays/s, {threads_used} threads)",
         scene_path.display(),
         output.display(),
         if first_pass > 0 {
