@@ -151,25 +151,9 @@ impl AreaLight {
                 Some(Distribution1D::new(&areas))
             }
         };
-        let fixed = match (shape, placement) {
-            (
-                Shape::Quad {
-                    origin,
-                    edge_u,
-                    edge_v,
-                },
-                Placement::Static(world_from_object),
-            ) => Some(Placed::Quad(WorldQuad::new(
-                world_from_object,
-                *origin,
-                *edge_u,
-                *edge_v,
-            ))),
-            (Shape::Sphere { center, radius }, Placement::Static(world_from_object)) => {
-                world_sphere(world_from_object, *center, *radius)
-                    .map(|(center, radius)| Placed::Sphere { center, radius })
-            }
-            _ => None,
+        let fixed = match placement {
+            Placement::Static(world_from_object) => place(shape, world_from_object),
+            Placement::Moving(_) => None,
         };
         Ok(AreaLight {
             instance,
@@ -203,24 +187,34 @@ impl AreaLight {
 
     /// Samples a direction from `p_ref` towards this light at `time`.
     pub fn sample_li(&self, p_ref: Vec3, time: f32, u2: Vec2) -> Option<LightSample> {
-        // Everything but cone-sampled spheres: a point by area, converted to solid angle.
-        let s = match self.fixed.as_deref() {
-            Some(Placed::Quad(quad)) => quad.sample(u2)?,
-            Some(&Placed::Sphere { center, radius }) => {
-                return self.sample_cone(p_ref, center, radius, u2);
-            }
+        // Quads, ellipsoids and meshes: a point by area, converted to solid angle; spheres
+        // that stay spheres: the cone they subtend.
+        let made;
+        let placed = match self.fixed.as_deref() {
+            Some(placed) => placed,
             None => {
                 let world_from_object = self.placement.at(time);
-                // Spheres that stay spheres: sample the cone they subtend.
-                if let Shape::Sphere { center, radius } = self.shape
-                    && let Some((c_world, r_world)) =
-                        world_sphere(&world_from_object, center, radius)
-                {
-                    return self.sample_cone(p_ref, c_world, r_world, u2);
+                made = place(&self.shape, &world_from_object);
+                match &made {
+                    Some(placed) => placed,
+                    None => {
+                        return self.seen_from(p_ref, self.sample_area(&world_from_object, u2)?);
+                    }
                 }
-                self.sample_area(&world_from_object, u2)?
             }
         };
+        let s = match *placed {
+            Placed::Quad(ref quad) => quad.sample(u2)?,
+            Placed::Sphere { center, radius } => {
+                return self.sample_cone(p_ref, center, radius, u2);
+            }
+        };
+        self.seen_from(p_ref, s)
+    }
+
+    /// The light sample of the surface point `s`, seen from `p_ref`: its area density turned
+    /// into solid angle; `None` when `p_ref` is on it or sees it edge on or from behind.
+    fn seen_from(&self, p_ref: Vec3, s: SurfacePoint) -> Option<LightSample> {
         let to_light = s.p - p_ref;
         let d2 = to_light.length_squared();
         if d2 <= TINY {
@@ -255,23 +249,29 @@ impl AreaLight {
         primitive: u32,
         time: f32,
     ) -> f32 {
-        match self.fixed.as_deref() {
-            Some(Placed::Quad(quad)) => {
-                return area_to_solid_angle(quad.pdf_area.unwrap_or(0.0), p_ref, p_light, n_light);
+        let made;
+        let placed = match self.fixed.as_deref() {
+            Some(placed) => placed,
+            None => {
+                let world_from_object = self.placement.at(time);
+                made = place(&self.shape, &world_from_object);
+                match &made {
+                    Some(placed) => placed,
+                    None => {
+                        let pdf_area = self.pdf_area(&world_from_object, p_light, primitive);
+                        return area_to_solid_angle(pdf_area, p_ref, p_light, n_light);
+                    }
+                }
             }
-            Some(&Placed::Sphere { center, radius }) => {
-                return sphere_pdf(center, radius, p_ref, p_light, n_light);
+        };
+        match *placed {
+            Placed::Quad(ref quad) => {
+                area_to_solid_angle(quad.pdf_area.unwrap_or(0.0), p_ref, p_light, n_light)
             }
-            None => {}
+            Placed::Sphere { center, radius } => {
+                sphere_pdf(center, radius, p_ref, p_light, n_light)
+            }
         }
-        let world_from_object = self.placement.at(time);
-        if let Shape::Sphere { center, radius } = self.shape
-            && let Some((c_world, r_world)) = world_sphere(&world_from_object, center, radius)
-        {
-            return sphere_pdf(c_world, r_world, p_ref, p_light, n_light);
-        }
-        let pdf_area = self.pdf_area(&world_from_object, p_light, primitive);
-        area_to_solid_angle(pdf_area, p_ref, p_light, n_light)
     }
 
     /// Cone sampling of a world-space sphere (pbrt's method), from outside it.
@@ -317,7 +317,8 @@ impl AreaLight {
         })
     }
 
-    /// A point uniform by world area on shapes other than cone-sampled spheres.
+    /// A point uniform by world area on the shapes [`place`] does not place: ellipsoids and
+    /// meshes (a quad is sampled as placed, never here).
     fn sample_area(
         &self,
         world_from_object: &Transform<World, Object>,
@@ -340,11 +341,7 @@ impl AreaLight {
                     pdf_area,
                 })
             }
-            Shape::Quad {
-                origin,
-                edge_u,
-                edge_v,
-            } => WorldQuad::new(world_from_object, *origin, *edge_u, *edge_v).sample(u2),
+            Shape::Quad { .. } => None,
             Shape::Mesh(mesh) => {
                 let by_area = self.by_area.as_ref()?;
                 let (i, p_triangle, u_remapped) = by_area.sample_discrete(u2.x);
@@ -384,13 +381,7 @@ impl AreaLight {
                 let jacobian = Mat3::from_mat4(m).determinant().abs() * n_mapped.length();
                 1.0 / (4.0 * PI * radius * radius * jacobian)
             }
-            Shape::Quad {
-                origin,
-                edge_u,
-                edge_v,
-            } => WorldQuad::new(world_from_object, *origin, *edge_u, *edge_v)
-                .pdf_area
-                .unwrap_or(0.0),
+            Shape::Quad { .. } => 0.0,
             Shape::Mesh(mesh) => {
                 let (Some(by_area), Some(tri)) = (&self.by_area, corners(mesh, primitive as usize))
                 else {
@@ -405,6 +396,28 @@ impl AreaLight {
                 }
             }
         }
+    }
+}
+
+/// The emitter `shape` placed in world space by `world_from_object`, for the shapes sampled
+/// in world space: a quad (by area) and a sphere the map keeps a sphere, a similarity (by its
+/// cone). `None` for an ellipsoid or a mesh, which are sampled through the map
+/// ([`AreaLight::sample_area`]). A static light keeps this; a moving one makes it per sample.
+fn place(shape: &Shape, world_from_object: &Transform<World, Object>) -> Option<Placed> {
+    match shape {
+        Shape::Quad {
+            origin,
+            edge_u,
+            edge_v,
+        } => Some(Placed::Quad(WorldQuad::new(
+            world_from_object,
+            *origin,
+            *edge_u,
+            *edge_v,
+        ))),
+        Shape::Sphere { center, radius } => world_sphere(world_from_object, *center, *radius)
+            .map(|(center, radius)| Placed::Sphere { center, radius }),
+        Shape::Mesh(_) => None,
     }
 }
 
