@@ -17,6 +17,7 @@ const TAG_STRATIFIED: u64 = 0x5354_5241_5449_4659;
 const TAG_HALTON: u64 = 0x4841_4c54_4f4e_0001;
 const TAG_HALTON_JITTER: u64 = 0x4841_4c54_4f4e_0002;
 const TAG_SOBOL: u64 = 0x534f_424f_4c00_0001;
+const TAG_TAIL: u64 = 0x534f_424f_4c00_0002;
 
 /// The finest strata a value is placed in: `2^24`, one `f32` ulp just below one.
 const MAX_STRATA: u32 = 1 << 24;
@@ -234,6 +235,11 @@ pub(crate) const fn sobol_second_bitwise(mut index: u32) -> u32 {
 /// interval of area `2^-m`; Owen scrambling keeps nets), and the film's first `2^k` samples
 /// are nets too.
 ///
+/// Only the first [`SOBOL_PAIRS`] pairs are Sobol's: the dimensions past them (a path's third
+/// bounce on) are independent values from [`tail_pair`], at a tenth of a scrambled pair's
+/// cost. Stratifying them measured no less error (docs/performance.md, "Sobol for the first
+/// two bounces").
+///
 /// Not a nested scramble of the index bits, although that would keep every pair's first `2^k`
 /// samples nets as well: it pairs the strata of different pairs with a structure of its own,
 /// which renders measured noisier (docs/performance.md, "The Sobol sampler's index shuffle").
@@ -242,8 +248,26 @@ pub(crate) const fn sobol_second_bitwise(mut index: u32) -> u32 {
 /// `places` is [`Permutation::new`] of the samples per pixel, which the sampler builds once.
 #[inline]
 pub(crate) fn sobol(key: u64, places: Permutation, index: u32, dimension: u32) -> f32 {
+    if dimension / 2 >= SOBOL_PAIRS {
+        return tail_pair(key, index, dimension / 2)[(dimension % 2) as usize];
+    }
     let prepared = sobol_prepare(key, SobolIndex::new(index, places), dimension / 2);
     sobol_coordinate(prepared, dimension % 2)
+}
+
+/// The pairs of dimensions the Sobol sampler stratifies: [`crate::SOBOL_DIMENSIONS`] / 2.
+pub(crate) const SOBOL_PAIRS: u32 = crate::SOBOL_DIMENSIONS / 2;
+
+/// Both values of a pair past [`SOBOL_PAIRS`]: the two halves of one hash of (pixel, sample
+/// index, pair), independent uniform values. `key` is the Sobol-tagged pixel key; `TAG_TAIL`
+/// keeps these hashes apart from the pairs' keys, which hash (pixel, pair) from the same key.
+#[inline]
+pub(crate) fn tail_pair(key: u64, index: u32, pair: u32) -> [f32; 2] {
+    let bits = combine(key ^ TAG_TAIL, u64::from(index) << 32 | u64::from(pair));
+    [
+        unit_f32_from_bits(bits as u32),
+        unit_f32_from_bits((bits >> 32) as u32),
+    ]
 }
 
 /// Where a sample index sits for Sobol's index shuffle: its block of `spp` indices and its
@@ -335,6 +359,9 @@ pub(crate) fn sobol_key(pixel_key: u64) -> u64 {
 /// docs/performance.md).
 #[inline]
 pub(crate) fn sobol_pair(key: u64, at: SobolIndex, pair: u32) -> [f32; 2] {
+    if pair >= SOBOL_PAIRS {
+        return tail_pair(key, at.start.wrapping_add(at.local), pair);
+    }
     let prepared = sobol_prepare(key, at, pair);
     let [raw0, raw1] = raw_pair(prepared.shuffled);
     let h0 = owen_hash(raw0, prepared.scramble_seed(0));
@@ -400,12 +427,17 @@ mod tests {
         }
     }
 
-    /// Sobol's values from their definition, one step at a time: the index's block of `spp`
+    /// Sobol's values from their definition, one step at a time (for the stratified pairs): the index's block of `spp`
     /// and its place in it, that place permuted per pair and block (not for the film pair),
     /// the raw coordinate (van der Corput or the second Sobol dimension, bit by bit), then its
     /// own Owen scramble.
     fn sobol_definition(key: u64, spp: u32, index: u32, dimension: u32) -> f32 {
         let pair = dimension / 2;
+        if pair >= crate::SOBOL_DIMENSIONS / 2 {
+            // Past the stratified pairs: one hash of (pixel, index, pair), low half first.
+            let bits = combine(key ^ TAG_TAIL, (u64::from(index) << 32) + u64::from(pair));
+            return unit_f32_from_bits((bits >> (32 * (dimension % 2))) as u32);
+        }
         let pair_key = combine(key, u64::from(pair));
         let block = index / spp;
         let shuffled = if pair == 0 {
@@ -431,8 +463,9 @@ mod tests {
             index: u32,
             pair in 0u32..1000,
         ) {
-            // The film pair, which is not shuffled, every time; another pair at random.
-            for pair in [0, pair] {
+            // The film pair, which is not shuffled, every time; a stratified pair and any pair
+            // (mostly past the stratified ones) at random.
+            for pair in [0, pair % SOBOL_PAIRS, pair] {
                 let expected = [
                     sobol_definition(key, spp, index, 2 * pair),
                     sobol_definition(key, spp, index, 2 * pair + 1),

@@ -1,6 +1,6 @@
 //! Samplers put exactly one sample in each stratum where they claim to.
 
-use obscura_sample::{Sampler, SamplerKind};
+use obscura_sample::{SOBOL_DIMENSIONS, Sampler, SamplerKind};
 use proptest::prelude::*;
 
 use crate::sampler;
@@ -115,6 +115,63 @@ fn sobol_later_passes_are_nets_too() {
     }
 }
 
+/// Pearson's chi-square statistic of `counts` against equal expected counts.
+fn chi_square(counts: &[u32]) -> f64 {
+    let total: u32 = counts.iter().sum();
+    let expected = f64::from(total) / counts.len() as f64;
+    counts
+        .iter()
+        .map(|&c| (f64::from(c) - expected).powi(2) / expected)
+        .sum()
+}
+
+#[test]
+fn sobol_past_its_dimensions_is_uniform_and_independent() {
+    // Past SOBOL_DIMENSIONS the values are hashes: not one per stratum, but uniform on the
+    // square of a pair. 4096 points (64 pixels x 64 samples) per pair in a 16 x 16 grid:
+    // chi-square with 255 degrees of freedom, whose 0.999 quantile is 330.5 (the
+    // Wilson-Hilferty approximation: 255 (1 - 2/2295 + 3.090 sqrt(2/2295))^3). A pair whose
+    // halves were equal, or a hash that ignored the index, would put every point on a line or
+    // in one cell, a statistic in the tens of thousands.
+    let s = sampler(SamplerKind::Sobol, 64, 4);
+    for first in [
+        SOBOL_DIMENSIONS,
+        SOBOL_DIMENSIONS + 2,
+        SOBOL_DIMENSIONS + 30,
+    ] {
+        let mut counts = [0u32; 256];
+        for p in 0..64u32 {
+            for index in 0..64 {
+                let pixel = [p % 8, p / 8];
+                let i = interval(s.value(pixel, index, first), 16);
+                let j = interval(s.value(pixel, index, first + 1), 16);
+                counts[(j * 16 + i) as usize] += 1;
+            }
+        }
+        let chi2 = chi_square(&counts);
+        assert!(
+            chi2 < 330.5,
+            "dimensions {first}, {}: chi-square {chi2}",
+            first + 1
+        );
+    }
+    // The last stratified pair is still a net; the first pair after it need not be (and with
+    // 64 points in 64 cells of a hash, is not).
+    let last = SOBOL_DIMENSIONS - 2;
+    assert_one_per_cell(&s, [3, 3], 0, [last, last + 1], [8, 8]);
+    let mut seen = [false; 64];
+    let mut twice = false;
+    for index in 0..64 {
+        let i = interval(s.value([3, 3], index, SOBOL_DIMENSIONS), 8);
+        let j = interval(s.value([3, 3], index, SOBOL_DIMENSIONS + 1), 8);
+        twice |= std::mem::replace(&mut seen[(j * 8 + i) as usize], true);
+    }
+    assert!(
+        twice,
+        "the pair past SOBOL_DIMENSIONS is a net: it is still stratified"
+    );
+}
+
 #[test]
 fn halton_fills_its_prime_power_strata() {
     // Dimension d uses the d-th prime: 2, 3, 5, 7, 11, 13, ...
@@ -168,7 +225,7 @@ proptest! {
     }
 
     #[test]
-    fn sobol_is_a_net_for_any_seed_and_pixel(seed: u64, pixel: [u32; 2], m in 0u32..9, pair in 0u32..50) {
+    fn sobol_is_a_net_for_any_seed_and_pixel(seed: u64, pixel: [u32; 2], m in 0u32..9, pair in 0u32..SOBOL_DIMENSIONS / 2) {
         let s = sampler(SamplerKind::Sobol, 1 << m, seed);
         for a in 0..=m {
             assert_one_per_cell(&s, pixel, 0, [2 * pair, 2 * pair + 1], [1 << a, 1 << (m - a)]);
