@@ -6,12 +6,17 @@
 //! entries per level it descends, so [`CAPACITY`] covers trees of nine levels (an eight-wide
 //! tree of a million triangles has about seven); a deeper one's further entries go to the
 //! vector, in the same last-in, first-out order.
+//!
+//! This is what `smallvec::SmallVec<[T; 64]>` is, written out because smallvec's push and pop
+//! first ask whether the vector has spilled, to find its buffer and capacity, where this one's
+//! array is always where it is: with smallvec the mesh comparison scene's render loop took
+//! 0.7% more instructions and was no faster (docs/performance.md, round 11).
 
 /// Entries held in the fixed array.
 pub(super) const CAPACITY: usize = 64;
 
 /// A last-in, first-out stack of traversal entries.
-#[derive(Clone, Debug)]
+#[derive(Debug)]
 pub(crate) struct Stack<T> {
     items: [T; CAPACITY],
     /// Entries in `items`; `spill` holds entries only when this is [`CAPACITY`].
