@@ -31,6 +31,23 @@ impl Filter {
         self.settings.radius()
     }
 
+    /// How many pixels beyond a tile's edge the tile's samples reach with a non-zero weight.
+    ///
+    /// A sample of pixel `i` lies in `[i, i + 1]` (the far edge when `i + offset` rounds up),
+    /// and [`Filter::eval_1d`] is non-zero only closer than the radius `r` to a pixel's
+    /// centre, or, for the box, at exactly `-r` (the centre on the side of larger
+    /// coordinates). So a centre beyond the edge is reached if it is less than `r` (the box:
+    /// at most `r`) from the edge: `ceil(r - 0.5)` pixels, `floor(r - 0.5) + 1` for the box.
+    /// The default Gaussian (`r = 1.5`) reaches one, not `ceil(r) = 2`.
+    pub fn margin(&self) -> u32 {
+        let beyond = self.radius() - 0.5;
+        let margin = match self.settings {
+            FilterSettings::Box { .. } => beyond.floor() + 1.0,
+            _ => beyond.ceil(),
+        };
+        margin.max(0.0) as u32
+    }
+
     /// The one-dimensional profile at offset `d` (zero outside the support).
     pub fn eval_1d(&self, d: f32) -> f32 {
         let r = self.radius();

@@ -4,7 +4,8 @@ use super::PixelRect;
 use super::filter::{Filter, SPAN};
 use glam::{Vec2, Vec3, Vec4};
 
-/// One tile's sums: the tile's pixels and a filter-wide margin, clipped to the film.
+/// One tile's sums: the tile's pixels and the margin its samples reach ([`Filter::margin`]),
+/// clipped to the film.
 ///
 /// A tile holds one pass, so each of its pixels sums at most the few samples its filter
 /// reaches (nine for the default Gaussian): f32 is exact enough there (relative error about
@@ -37,7 +38,7 @@ impl TileBuffer {
     /// Makes this buffer a zeroed one for `tile`, as [`TileBuffer::new`] would, keeping its
     /// memory (the renderer recycles buffers instead of allocating one per tile and pass).
     pub fn reset(&mut self, tile: PixelRect, film: PixelRect) {
-        let m = self.filter.radius().ceil() as u32;
+        let m = self.filter.margin();
         self.rect = PixelRect {
             x0: tile.x0.saturating_sub(m).max(film.x0),
             y0: tile.y0.saturating_sub(m).max(film.y0),
@@ -193,6 +194,66 @@ mod tests {
             let got = floor(Vec2::new(x, -x));
             assert_eq!(got, Vec2::new(x.floor(), (-x).floor()), "{x}");
         }
+    }
+
+    proptest::proptest! {
+        /// A tile's buffer holds every pixel its samples give a weight to: a sample splatted
+        /// into the tile's buffer and into one covering the whole film gives the same film,
+        /// for samples on the tile's edges, including one whose position rounds onto the far
+        /// edge (far from the origin, where `pixel + offset` rounds up to the next pixel).
+        #[test]
+        fn the_margin_keeps_every_weight_of_a_tile_sample(
+            kind in 0usize..4,
+            radius in proptest::sample::select(vec![0.25f32, 0.5, 0.75, 1.0, 1.5, 2.0, 2.5, 3.0, 5.3]),
+            far in proptest::bool::ANY,
+            pixel in (0u32..16, 0u32..16),
+            place in (0usize..3, 0usize..5, 0usize..3, 0usize..5),
+            offset in (0.0f32..1.0, 0.0f32..1.0),
+        ) {
+            let settings = match kind {
+                0 => FilterSettings::Box { radius },
+                1 => FilterSettings::Triangle { radius },
+                2 => FilterSettings::Gaussian { radius },
+                _ => FilterSettings::Mitchell { radius },
+            };
+            let filter = Filter::new(settings);
+            // At 2^20 an f32 steps by 2^-3, so offsets of 15/16 and more round up.
+            let origin = if far { 1u32 << 20 } else { 8 };
+            let film_r = PixelRect { x0: origin - 8, y0: origin - 8, x1: origin + 24, y1: origin + 24 };
+            let tile_r = PixelRect { x0: origin, y0: origin, x1: origin + 16, y1: origin + 16 };
+            // Each axis: the first or last pixel of the tile, or a random one; an offset of 0,
+            // the largest below 1, one just above 0, one half, or a random one.
+            let offsets = [0.0, 1.0 - f32::EPSILON / 2.0, 1e-7, 0.5];
+            let coordinate = |which: usize, random_pixel: u32, at: usize, random: f32| {
+                let pixel = [0, 15, random_pixel][which];
+                (origin + pixel) as f32 + offsets.get(at).copied().unwrap_or(random)
+            };
+            let p = Vec2::new(
+                coordinate(place.0, pixel.0, place.1, offset.0),
+                coordinate(place.2, pixel.1, place.3, offset.1),
+            );
+            let mut films = [Film::new(film_r), Film::new(film_r)];
+            for (film, rect) in films.iter_mut().zip([tile_r, film_r]) {
+                let mut buffer = TileBuffer::new(rect, film_r, filter);
+                buffer.add_sample(p, Vec3::new(1.0, 2.0, 3.0), true);
+                film.merge(&buffer);
+            }
+            proptest::prop_assert!(films[0] == films[1], "{:?} at {:?}", settings, p);
+        }
+    }
+
+    #[test]
+    fn margins_by_hand() {
+        let margin = |settings| Filter::new(settings).margin();
+        // A centre 0.5 beyond the edge is reached by a box of radius 0.5 (at exactly -r).
+        assert_eq!(margin(FilterSettings::Box { radius: 0.5 }), 1);
+        assert_eq!(margin(FilterSettings::Box { radius: 0.25 }), 0);
+        assert_eq!(margin(FilterSettings::Box { radius: 1.5 }), 2);
+        // The Gaussian of radius 1.5 is zero 1.5 from a centre: the second ring gets nothing.
+        assert_eq!(margin(FilterSettings::Gaussian { radius: 1.5 }), 1);
+        assert_eq!(margin(FilterSettings::Triangle { radius: 1.0 }), 1);
+        assert_eq!(margin(FilterSettings::Mitchell { radius: 2.0 }), 2);
+        assert_eq!(margin(FilterSettings::Triangle { radius: 5.3 }), 5);
     }
 
     /// Every pixel gets exactly the separable weight `f(dx) f(dy)` of the sample, for a
