@@ -427,10 +427,10 @@ mod tests {
         }
     }
 
-    /// Sobol's values from their definition, one step at a time (for the stratified pairs): the index's block of `spp`
-    /// and its place in it, that place permuted per pair and block (not for the film pair),
-    /// the raw coordinate (van der Corput or the second Sobol dimension, bit by bit), then its
-    /// own Owen scramble.
+    /// Sobol's values from their definition, one step at a time. A stratified pair: the
+    /// index's block of `spp` and its place in it, that place permuted per pair and block (not
+    /// for the film pair), the raw coordinate (van der Corput or the second Sobol dimension,
+    /// bit by bit), then its own Owen scramble. A later pair: one hash, split in two.
     fn sobol_definition(key: u64, spp: u32, index: u32, dimension: u32) -> f32 {
         let pair = dimension / 2;
         if pair >= crate::SOBOL_DIMENSIONS / 2 {

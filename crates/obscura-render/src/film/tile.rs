@@ -204,7 +204,9 @@ mod tests {
         #[test]
         fn the_margin_keeps_every_weight_of_a_tile_sample(
             kind in 0usize..4,
-            radius in proptest::sample::select(vec![0.25f32, 0.5, 0.75, 1.0, 1.5, 2.0, 2.5, 3.0, 5.3]),
+            radius in proptest::sample::select(
+                vec![0.25f32, 0.5, 0.75, 1.0, 1.5, 2.0, 2.5, 3.0, 5.3]
+            ),
             far in proptest::bool::ANY,
             pixel in (0u32..16, 0u32..16),
             place in (0usize..3, 0usize..5, 0usize..3, 0usize..5),
@@ -219,8 +221,13 @@ mod tests {
             let filter = Filter::new(settings);
             // At 2^20 an f32 steps by 2^-3, so offsets of 15/16 and more round up.
             let origin = if far { 1u32 << 20 } else { 8 };
-            let film_r = PixelRect { x0: origin - 8, y0: origin - 8, x1: origin + 24, y1: origin + 24 };
-            let tile_r = PixelRect { x0: origin, y0: origin, x1: origin + 16, y1: origin + 16 };
+            let square = |start: u32, size: u32| PixelRect {
+                x0: start,
+                y0: start,
+                x1: start + size,
+                y1: start + size,
+            };
+            let (film_r, tile_r) = (square(origin - 8, 32), square(origin, 16));
             // Each axis: the first or last pixel of the tile, or a random one; an offset of 0,
             // the largest below 1, one just above 0, one half, or a random one.
             let offsets = [0.0, 1.0 - f32::EPSILON / 2.0, 1e-7, 0.5];

@@ -225,7 +225,12 @@ proptest! {
     }
 
     #[test]
-    fn sobol_is_a_net_for_any_seed_and_pixel(seed: u64, pixel: [u32; 2], m in 0u32..9, pair in 0u32..SOBOL_DIMENSIONS / 2) {
+    fn sobol_is_a_net_for_any_seed_and_pixel(
+        seed: u64,
+        pixel: [u32; 2],
+        m in 0u32..9,
+        pair in 0u32..SOBOL_DIMENSIONS / 2,
+    ) {
         let s = sampler(SamplerKind::Sobol, 1 << m, seed);
         for a in 0..=m {
             assert_one_per_cell(&s, pixel, 0, [2 * pair, 2 * pair + 1], [1 << a, 1 << (m - a)]);
