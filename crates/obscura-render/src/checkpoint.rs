@@ -6,7 +6,7 @@
 //! ```text
 //! magic        8 bytes  "OBSCKPT\0"
 //! version      u32      CHECKPOINT_VERSION
-//! fingerprint  u64      scene_fingerprint(): what determines the image
+//! fingerprint  u64      scene_fingerprint(): what determines the image, sampler values included
 //! spp          u32      samples per pixel the render is going to
 //! passes_done  u32      complete passes in the sums (<= spp)
 //! bounds       4 x u32  x0, y0, x1, y1 of the film's pixel bounds
@@ -59,14 +59,20 @@ fn fnv1a(mut hash: u64, bytes: &[u8]) -> u64 {
 
 const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
 
-/// A fingerprint of everything that determines the image: the scene file's bytes and every
+/// A fingerprint of everything that determines the image: the scene file's bytes, every
 /// setting after the command line's overrides (resolution, filter, sampler, spp, seed,
-/// integrator, camera, materials, shapes, lights). Thread counts do not enter: they do not
-/// change the image. Files the scene names (meshes, environment maps) enter by path only.
+/// integrator, camera, materials, shapes, lights) and which values this build's samplers give
+/// ([`obscura_sample::SEQUENCE_VERSION`]). Thread counts do not enter: they do not change the
+/// image. Files the scene names (meshes, environment maps) enter by path only.
 pub fn scene_fingerprint(source: &[u8], description: &SceneDescription) -> u64 {
+    fingerprint_with(source, description, obscura_sample::SEQUENCE_VERSION)
+}
+
+/// [`scene_fingerprint`] for a build whose samplers' values are `sequence_version`.
+fn fingerprint_with(source: &[u8], description: &SceneDescription, sequence_version: u32) -> u64 {
     let d = description;
     let settings = format!(
-        "{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}",
+        "{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|sequences {sequence_version}",
         d.film, d.sampler, d.integrator, d.camera, d.materials, d.shapes, d.lights
     );
     let hash = fnv1a(FNV_OFFSET, &(source.len() as u64).to_le_bytes());
@@ -197,7 +203,7 @@ impl Checkpoint {
         }
         if self.fingerprint != fingerprint {
             return Err(bad(
-                "made from a different scene file or settings (seed, integrator, overrides); resume with the same scene and flags".into(),
+                "made from a different scene file or settings (seed, integrator, overrides), or by a build whose samplers give other values; resume with the same scene, flags and build".into(),
             ));
         }
         Ok(())
@@ -377,6 +383,29 @@ mod tests {
                 .contains("format version 1, this obscura reads version 2"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn the_fingerprint_follows_the_samplers_values() {
+        let source = r#"
+            [film]
+            resolution = [8, 8]
+            [camera]
+            eye = [0.0, 0.0, 3.0]
+            target = [0.0, 0.0, 0.0]
+            fov = 30.0
+        "#;
+        let d = crate::parse_description(Path::new("s.toml"), source).unwrap();
+        let this = scene_fingerprint(source.as_bytes(), &d);
+        let version = obscura_sample::SEQUENCE_VERSION;
+        assert_eq!(this, fingerprint_with(source.as_bytes(), &d, version));
+        // A build whose samplers give other values makes films that must not be resumed or
+        // merged with this build's.
+        assert_ne!(this, fingerprint_with(source.as_bytes(), &d, version + 1));
+        // And the scene's settings still count.
+        let mut other = d.clone();
+        other.sampler.seed += 1;
+        assert_ne!(this, scene_fingerprint(source.as_bytes(), &other));
     }
 
     #[test]

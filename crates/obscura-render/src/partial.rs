@@ -12,7 +12,7 @@
 //! ```text
 //! magic        8 bytes   "OBSPART\0"
 //! version      u32       PARTIAL_VERSION
-//! fingerprint  u64       scene_fingerprint(): the scene file and every setting
+//! fingerprint  u64       scene_fingerprint(): the scene file, every setting, the sampler values
 //! seed         u64       sampler seed
 //! spp          u32       samples per pixel of the whole render
 //! integrator   16 bytes  its name, zero-padded
@@ -324,7 +324,8 @@ impl Partial {
         }
         if a.fingerprint != b.fingerprint {
             return Some(
-                "another scene: the scene file or a setting differs (fingerprints do not match)"
+                "another scene: the scene file, a setting or the build's sampler values differ \
+                 (fingerprints do not match)"
                     .into(),
             );
         }

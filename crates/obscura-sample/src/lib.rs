@@ -59,7 +59,9 @@ mod warp;
 pub use distribution::{Distribution1D, Distribution2D, GridCell, SearchStart};
 pub use error::SampleError;
 pub use hash::ONE_MINUS_EPSILON;
-pub use sampler::{MAX_SAMPLES_PER_PIXEL, SOBOL_DIMENSIONS, SampleStream, Sampler, SamplerKind};
+pub use sampler::{
+    MAX_SAMPLES_PER_PIXEL, SEQUENCE_VERSION, SOBOL_DIMENSIONS, SampleStream, Sampler, SamplerKind,
+};
 pub use shutter::{PiecewiseShutterCurve, ShutterCurve, shutter_time};
 pub use trig::{sin_cos_pi, sin_cos_pi_vec4};
 pub use warp::{

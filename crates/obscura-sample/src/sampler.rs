@@ -20,6 +20,15 @@ pub const MAX_SAMPLES_PER_PIXEL: u32 = 1 << 24;
 /// stratifying a path's later bounces measured no less error, at ten times the cost per pair.
 pub const SOBOL_DIMENSIONS: u32 = 20;
 
+/// Which values the samplers give: raised whenever some sampler's value for some (pixel,
+/// sample index, dimension, seed) changes, as it did when Sobol's index shuffle changed and
+/// when Sobol stopped stratifying past [`SOBOL_DIMENSIONS`]. Films from renders with other
+/// values are unbiased but not the image this build renders, so the renderer's scene
+/// fingerprint includes this number: checkpoints and slices from a build with other values
+/// are refused rather than resumed or merged into an image that is not bit for bit the
+/// one-process image.
+pub const SEQUENCE_VERSION: u32 = 1;
+
 /// The four sample generators of the scene format's `[sampler] type`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum SamplerKind {
