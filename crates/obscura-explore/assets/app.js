@@ -212,12 +212,20 @@ function takeView(msg) {
   scheduleCompare();
 }
 
+// Frames decode concurrently; only the latest received is drawn, so a frame that finishes
+// decoding after a later one cannot put an older pass back on the canvas.
+let framesReceived = 0;
 async function onFrame(buffer) {
+  const seq = ++framesReceived;
   const head = new DataView(buffer, 0, 12);
   const generation = head.getUint32(0, true);
   const pass = head.getUint32(4, true);
   const passes = head.getUint32(8, true);
   const bitmap = await createImageBitmap(new Blob([buffer.slice(12)], { type: 'image/png' }));
+  if (seq !== framesReceived) {
+    bitmap.close();
+    return;
+  }
   if (canvas.width !== bitmap.width || canvas.height !== bitmap.height) {
     canvas.width = bitmap.width;
     canvas.height = bitmap.height;

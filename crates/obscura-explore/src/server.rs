@@ -487,6 +487,11 @@ async fn websocket(
 /// The socket's conversation: a hello, then frames out and changes in until either side
 /// closes.
 async fn talk(mut socket: WebSocket, id: u64, session: Arc<Session>) {
+    // A new receiver counts the frame already sent as seen; marked unseen, it goes out after
+    // the hello. Otherwise a view whose last pass was done before the socket opened (a small
+    // scene, a slow browser) never reached the page.
+    let mut frames = session.frames();
+    frames.mark_changed();
     let mut hello = view_json(&session.view());
     hello["type"] = json!("hello");
     hello["session"] = json!(id);
@@ -497,7 +502,6 @@ async fn talk(mut socket: WebSocket, id: u64, session: Arc<Session>) {
     {
         return;
     }
-    let mut frames = session.frames();
     loop {
         tokio::select! {
             changed = frames.changed() => {

@@ -406,6 +406,38 @@ async fn the_websocket_streams_frames_and_takes_changes() {
 }
 
 #[tokio::test]
+async fn a_socket_opened_after_the_last_pass_still_gets_the_frame() {
+    let x = explorer(2);
+    let (status, s) = call_json(&x, "POST", "/api/session", "").await;
+    assert_eq!(status, StatusCode::CREATED, "{s}");
+    let id = s["session"].as_u64().unwrap();
+    // The view is rendered to its end before any socket listens.
+    wait_status(&x, id, |s| s["passes_done"] == json!(2)).await;
+    let listener = tokio::net::TcpListener::bind("127.0.0.1:0").await.unwrap();
+    let addr = listener.local_addr().unwrap();
+    let app = router(x.clone());
+    let server = tokio::spawn(async move { axum::serve(listener, app).await });
+    let (mut ws, _) = tokio_tungstenite::connect_async(format!("ws://{addr}/api/ws?session={id}"))
+        .await
+        .unwrap();
+    // The hello, then the finished frame (a bound, so a frame that never comes fails the
+    // test instead of hanging it).
+    let frame = tokio::time::timeout(std::time::Duration::from_secs(30), async {
+        loop {
+            if let Message::Binary(b) = ws.next().await.unwrap().unwrap() {
+                break b;
+            }
+        }
+    })
+    .await
+    .expect("the finished view's frame reaches a socket opened after it");
+    let word = |i: usize| u32::from_le_bytes(frame[i * 4..i * 4 + 4].try_into().unwrap());
+    assert_eq!((word(0), word(1), word(2)), (0, 2, 2));
+    assert_eq!(&frame[12..16], b"\x89PNG");
+    server.abort();
+}
+
+#[tokio::test]
 async fn pages_past_the_limit_are_refused_and_the_server_keeps_answering() {
     let x = explorer(4);
     let mut ids = Vec::new();
