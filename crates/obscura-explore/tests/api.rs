@@ -83,6 +83,23 @@ async fn wait_status(x: &Arc<Explorer>, id: u64, done: impl Fn(&Value) -> bool) 
     panic!("session {id} never reached the state asked for");
 }
 
+/// The explorer's router on a loopback listener (for the WebSocket tests): its address and
+/// the server's task.
+async fn serve(
+    x: &Arc<Explorer>,
+) -> (
+    std::net::SocketAddr,
+    tokio::task::JoinHandle<std::io::Result<()>>,
+) {
+    let listener = tokio::net::TcpListener::bind("127.0.0.1:0").await.unwrap();
+    let addr = listener.local_addr().unwrap();
+    let app = router(x.clone());
+    (
+        addr,
+        tokio::spawn(async move { axum::serve(listener, app).await }),
+    )
+}
+
 #[tokio::test]
 async fn the_page_and_its_assets_come_from_the_server_only() {
     let x = explorer(1);
@@ -333,10 +350,7 @@ async fn many_quick_changes_leave_one_render() {
 #[tokio::test]
 async fn the_websocket_streams_frames_and_takes_changes() {
     let x = explorer(4);
-    let listener = tokio::net::TcpListener::bind("127.0.0.1:0").await.unwrap();
-    let addr = listener.local_addr().unwrap();
-    let app = router(x.clone());
-    let server = tokio::spawn(async move { axum::serve(listener, app).await });
+    let (addr, server) = serve(&x).await;
     let (mut ws, _) = tokio_tungstenite::connect_async(format!("ws://{addr}/api/ws"))
         .await
         .unwrap();
@@ -413,10 +427,7 @@ async fn a_socket_opened_after_the_last_pass_still_gets_the_frame() {
     let id = s["session"].as_u64().unwrap();
     // The view is rendered to its end before any socket listens.
     wait_status(&x, id, |s| s["passes_done"] == json!(2)).await;
-    let listener = tokio::net::TcpListener::bind("127.0.0.1:0").await.unwrap();
-    let addr = listener.local_addr().unwrap();
-    let app = router(x.clone());
-    let server = tokio::spawn(async move { axum::serve(listener, app).await });
+    let (addr, server) = serve(&x).await;
     let (mut ws, _) = tokio_tungstenite::connect_async(format!("ws://{addr}/api/ws?session={id}"))
         .await
         .unwrap();
