@@ -71,6 +71,13 @@ async fn call_json(x: &Arc<Explorer>, method: &str, uri: &str, body: &str) -> (S
     (status, v)
 }
 
+/// Opens a session (as a new page does) and returns its id.
+async fn new_session(x: &Arc<Explorer>) -> u64 {
+    let (status, s) = call_json(x, "POST", "/api/session", "").await;
+    assert_eq!(status, StatusCode::CREATED, "{s}");
+    s["session"].as_u64().unwrap()
+}
+
 /// Waits until the session's status satisfies `done` (bounded: 2000 polls of 5 ms).
 async fn wait_status(x: &Arc<Explorer>, id: u64, done: impl Fn(&Value) -> bool) -> Value {
     for _ in 0..2000 {
@@ -226,9 +233,7 @@ async fn coordinates_follow_the_space_conventions() {
 #[tokio::test]
 async fn a_session_renders_saves_and_focuses() {
     let x = explorer(2);
-    let (status, s) = call_json(&x, "POST", "/api/session", "").await;
-    assert_eq!(status, StatusCode::CREATED, "{s}");
-    let id = s["session"].as_u64().unwrap();
+    let id = new_session(&x).await;
     wait_status(&x, id, |s| s["passes_done"] == json!(2)).await;
 
     let (status, png) = call(&x, "GET", &format!("/api/image.png?session={id}"), "").await;
@@ -422,9 +427,7 @@ async fn the_websocket_streams_frames_and_takes_changes() {
 #[tokio::test]
 async fn a_socket_opened_after_the_last_pass_still_gets_the_frame() {
     let x = explorer(2);
-    let (status, s) = call_json(&x, "POST", "/api/session", "").await;
-    assert_eq!(status, StatusCode::CREATED, "{s}");
-    let id = s["session"].as_u64().unwrap();
+    let id = new_session(&x).await;
     // The view is rendered to its end before any socket listens.
     wait_status(&x, id, |s| s["passes_done"] == json!(2)).await;
     let (addr, server) = serve(&x).await;
@@ -453,9 +456,7 @@ async fn pages_past_the_limit_are_refused_and_the_server_keeps_answering() {
     let x = explorer(4);
     let mut ids = Vec::new();
     for _ in 0..obscura_explore::MAX_SESSIONS {
-        let (status, s) = call_json(&x, "POST", "/api/session", "").await;
-        assert_eq!(status, StatusCode::CREATED, "{s}");
-        ids.push(s["session"].as_u64().unwrap());
+        ids.push(new_session(&x).await);
     }
     let (status, v) = call_json(&x, "POST", "/api/session", "").await;
     assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{v}");
