@@ -73,6 +73,7 @@ impl RenderScene {
         let mut builder = SceneBuilder::new().with_uv(false);
         let mut instance_material = Vec::new();
         let mut emitters = Vec::new();
+        let mut placed = Vec::new();
         let mut meshes: HashMap<PathBuf, Arc<TriangleMesh>> = HashMap::new();
         let mut skipped_triangles = Vec::new();
         for s in &d.shapes {
@@ -130,8 +131,9 @@ impl RenderScene {
                 .map_err(|e| d.error(key.clone(), e.to_string()))?;
             instance_material.push(s.material.map_or(default_index, |m| m as u32));
             if let Some(e) = s.emission {
-                emitters.push((instance, shape, placement, Vec3::from(e)));
+                emitters.push((instance, shape.clone(), placement.clone(), Vec3::from(e)));
             }
+            placed.push((instance, shape, placement));
         }
         let geometry = builder
             .build()
@@ -179,8 +181,9 @@ impl RenderScene {
             .map_err(|e| d.error(key, e.to_string()))?;
             lights.push(light);
         }
-        let shading = ShadingScene::new(materials, instance_material, lights, emitters)
+        let mut shading = ShadingScene::new(materials, instance_material, lights, emitters)
             .map_err(|e| d.error("lights", e.to_string()))?;
+        shading.aim_at_specular(placed.iter().map(|(i, s, p)| (*i, s, p)));
         let sampler = Sampler::new(d.sampler.kind, d.sampler.spp, d.sampler.seed)
             .map_err(|e| d.error("sampler", e.to_string()))?;
         let filter = Filter::new(d.film.filter);

@@ -61,18 +61,28 @@ const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
 
 /// A fingerprint of everything that determines the image: the scene file's bytes, every
 /// setting after the command line's overrides (resolution, filter, sampler, spp, seed,
-/// integrator, camera, materials, shapes, lights) and which values this build's samplers give
-/// ([`obscura_sample::SEQUENCE_VERSION`]). Thread counts do not enter: they do not change the
+/// integrator, camera, materials, shapes, lights), which values this build's samplers give
+/// ([`obscura_sample::SEQUENCE_VERSION`]) and which its path tracer gives
+/// ([`obscura_shade::ESTIMATOR_VERSION`]). Thread counts do not enter: they do not change the
 /// image. Files the scene names (meshes, environment maps) enter by path only.
 pub fn scene_fingerprint(source: &[u8], description: &SceneDescription) -> u64 {
-    fingerprint_with(source, description, obscura_sample::SEQUENCE_VERSION)
+    fingerprint_with(
+        source,
+        description,
+        [
+            obscura_sample::SEQUENCE_VERSION,
+            obscura_shade::ESTIMATOR_VERSION,
+        ],
+    )
 }
 
-/// [`scene_fingerprint`] for a build whose samplers' values are `sequence_version`.
-fn fingerprint_with(source: &[u8], description: &SceneDescription, sequence_version: u32) -> u64 {
+/// [`scene_fingerprint`] for a build whose samplers' and path tracer's values are
+/// `[sequence_version, estimator_version]`.
+fn fingerprint_with(source: &[u8], description: &SceneDescription, versions: [u32; 2]) -> u64 {
     let d = description;
+    let [sequence_version, estimator_version] = versions;
     let settings = format!(
-        "{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|sequences {sequence_version}",
+        "{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|sequences {sequence_version}|estimator {estimator_version}",
         d.film, d.sampler, d.integrator, d.camera, d.materials, d.shapes, d.lights
     );
     let hash = fnv1a(FNV_OFFSET, &(source.len() as u64).to_le_bytes());
@@ -397,11 +407,21 @@ mod tests {
         "#;
         let d = crate::parse_description(Path::new("s.toml"), source).unwrap();
         let this = scene_fingerprint(source.as_bytes(), &d);
-        let version = obscura_sample::SEQUENCE_VERSION;
-        assert_eq!(this, fingerprint_with(source.as_bytes(), &d, version));
-        // A build whose samplers give other values makes films that must not be resumed or
-        // merged with this build's.
-        assert_ne!(this, fingerprint_with(source.as_bytes(), &d, version + 1));
+        let (seq, est) = (
+            obscura_sample::SEQUENCE_VERSION,
+            obscura_shade::ESTIMATOR_VERSION,
+        );
+        assert_eq!(this, fingerprint_with(source.as_bytes(), &d, [seq, est]));
+        // A build whose samplers or path tracer give other values makes films that must not
+        // be resumed or merged with this build's.
+        assert_ne!(
+            this,
+            fingerprint_with(source.as_bytes(), &d, [seq + 1, est])
+        );
+        assert_ne!(
+            this,
+            fingerprint_with(source.as_bytes(), &d, [seq, est + 1])
+        );
         // And the scene's settings still count.
         let mut other = d.clone();
         other.sampler.seed += 1;

@@ -3,8 +3,9 @@
 
 use crate::error::ShadeError;
 use crate::frame::Frame;
+use crate::guide::{Aim, Casters, ONE_MINUS_EPSILON};
 use crate::light::{AreaLight, Light};
-use crate::material::Material;
+use crate::material::{BsdfSample, Material};
 use glam::{Vec2, Vec3};
 use obscura_accel::{Hit, Placement, Scene, Shape};
 use obscura_sample::{SampleStream, SearchStart};
@@ -90,6 +91,8 @@ pub struct ShadingScene {
     instance_light: Vec<Option<u32>>,
     /// Indices in `lights` of the environment lights (seen by rays that escape).
     environment: Vec<u32>,
+    /// The smooth specular objects diffuse vertices aim a share of their samples at.
+    casters: Casters,
 }
 
 impl ShadingScene {
@@ -151,7 +154,32 @@ impl ShadingScene {
             lights,
             instance_light,
             environment,
+            casters: Casters::default(),
         })
+    }
+
+    /// Makes diffuse vertices aim half of their BSDF samples at the smooth specular objects
+    /// among `instances` (`(instance, shape, placement)`, instances numbered as for
+    /// [`ShadingScene::new`]): the static ones whose material is all delta lobes (glass,
+    /// mirrors), each by the cone its bounding sphere subtends. Caustics, light focused by such
+    /// an object onto a diffuse surface, are then found far more often; the estimate stays
+    /// unbiased (the samples are weighted by the mixture's density). Instances with an unknown
+    /// number are ignored. Without this call no sample is aimed.
+    pub fn aim_at_specular<'a>(
+        &mut self,
+        instances: impl IntoIterator<Item = (u32, &'a Shape, &'a Placement)>,
+    ) {
+        let casters = Casters::new(
+            instances
+                .into_iter()
+                .filter_map(|(i, shape, placement)| Some((self.material(i)?, shape, placement))),
+        );
+        self.casters = casters;
+    }
+
+    /// How many objects diffuse vertices aim samples at ([`ShadingScene::aim_at_specular`]).
+    pub fn caster_count(&self) -> usize {
+        self.casters.len()
     }
 
     /// All lights, area lights last.
@@ -242,6 +270,13 @@ pub struct PathIntegrator {
     /// The largest number of bounces.
     pub max_depth: u32,
 }
+
+/// Which values the path tracer gives for the same scene and random numbers: raised whenever
+/// its estimator changes (1 before diffuse vertices aimed at casters, 2 since). Films made by
+/// a build with another estimator are unbiased but not this build's image, so the renderer's
+/// scene fingerprint includes this number, as it includes the samplers'
+/// `obscura_sample::SEQUENCE_VERSION`.
+pub const ESTIMATOR_VERSION: u32 = 2;
 
 /// Densities below this are treated as zero (the path ends instead of dividing by them).
 const MIN_PDF: f32 = 1e-12;
@@ -490,6 +525,12 @@ impl PathIntegrator {
             return (None, false);
         }
 
+        // A diffuse vertex in a scene with casters aims part of its samples at them.
+        let aim = aims(shading, material).then(|| {
+            let n = if wo.z < 0.0 { -frame.n } else { frame.n };
+            shading.casters.at(hit.p.to_glam(), n)
+        });
+
         // Next-event estimation: one light, chosen uniformly.
         let mut shadow = None;
         if shading.samples_light_on(material) {
@@ -508,7 +549,7 @@ impl PathIntegrator {
                     map_row: None,
                 },
             };
-            match self.sample_light(shading, &hit, material, &frame, wo, numbers) {
+            match self.sample_light(shading, &hit, material, &frame, wo, aim.as_ref(), numbers) {
                 Some((value, ray)) => {
                     shadow = Some(Shadow {
                         beta: path.beta,
@@ -524,7 +565,11 @@ impl PathIntegrator {
         // Only a material with a choice of lobes reads `u` (see Material::reads_lobe_choice).
         let u = dims.next_1d_if(material.reads_lobe_choice());
         let u2 = dims.next_2d();
-        let Some(bs) = material.sample(wo, u, u2) else {
+        let sampled = match &aim {
+            Some(aim) => sample_aimed(aim, material, &frame, wo, u2),
+            None => material.sample(wo, u, u2),
+        };
+        let Some(bs) = sampled else {
             return (shadow, false);
         };
         if bs.pdf < MIN_PDF || bs.f == Vec3::ZERO {
@@ -604,6 +649,7 @@ impl PathIntegrator {
         material: &Material,
         frame: &Frame,
         wo: Vec3,
+        aim: Option<&Aim>,
         numbers: LightNumbers,
     ) -> Option<(Vec3, Ray<World>)> {
         let count = shading.lights.len();
@@ -631,11 +677,64 @@ impl PathIntegrator {
             f * ls.radiance / light_select
         } else {
             let pdf_light = light_select * ls.pdf;
-            let weight = power_heuristic(pdf_light, material.pdf(wo, wi));
+            let mut pdf_bsdf = material.pdf(wo, wi);
+            if let Some(aim) = aim {
+                pdf_bsdf = aim.mixture_pdf(ls.wi, pdf_bsdf, None);
+            }
+            let weight = power_heuristic(pdf_light, pdf_bsdf);
             f * ls.radiance * weight / pdf_light
         };
         Some((value, shadow))
     }
+}
+
+/// Whether a vertex on `material` aims part of its samples at casters: a diffuse one, in a
+/// scene with casters.
+#[inline(always)]
+fn aims(shading: &ShadingScene, material: &Material) -> bool {
+    matches!(material, Material::Diffuse { .. }) && !shading.casters.is_empty()
+}
+
+/// A direction from the mixture of the BSDF's sampling and the casters' cones (the first
+/// [`Aim::share`] of `u2.x`'s range aims at a caster, the rest samples the BSDF, each with
+/// the number rescaled to `[0, 1)`), with the mixture's density as its `pdf`.
+#[inline]
+fn sample_aimed(
+    aim: &Aim,
+    material: &Material,
+    frame: &Frame,
+    wo: Vec3,
+    u2: Vec2,
+) -> Option<BsdfSample> {
+    let share = aim.share();
+    let rescale = |x: f32, lo: f32, width: f32| ((x - lo) / width).clamp(0.0, ONE_MINUS_EPSILON);
+    let aimed = if u2.x < share {
+        aim.sample(Vec2::new(rescale(u2.x, 0.0, share), u2.y))
+    } else {
+        None
+    };
+    let (bs, w, drawn) = match aimed {
+        Some((w, k)) => {
+            let wi = frame.to_local(w);
+            let bs = BsdfSample {
+                wi,
+                f: material.eval(wo, wi),
+                pdf: material.pdf(wo, wi),
+                specular: false,
+                eta: 1.0,
+            };
+            (bs, w, Some(k))
+        }
+        None => {
+            let u = Vec2::new(rescale(u2.x, share, 1.0 - share), u2.y);
+            let bs = material.sample(wo, 0.0, u)?;
+            (bs, frame.from_local(bs.wi), None)
+        }
+    };
+    Some(BsdfSample {
+        pdf: aim.mixture_pdf(w, bs.pdf, drawn),
+        ..bs
+    })
 }
 
 /// What a round's prefetch sweep found for a path's coming vertex, which the vertex then

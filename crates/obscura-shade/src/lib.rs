@@ -64,13 +64,16 @@
 
 mod error;
 mod frame;
+mod guide;
 mod integrator;
 mod light;
 mod material;
 
 pub use error::ShadeError;
 pub use frame::Frame;
-pub use integrator::{PathIntegrator, SampleDims, ShadingScene, power_heuristic, rr_survival};
+pub use integrator::{
+    ESTIMATOR_VERSION, PathIntegrator, SampleDims, ShadingScene, power_heuristic, rr_survival,
+};
 pub use light::{
     AreaLight, EnvironmentLight, Light, LightSample, direction_to_uv, luminance, uv_to_direction,
 };

@@ -1,0 +1,539 @@
+//! Aiming at casters: a diffuse vertex sends a share of its BSDF samples into the cones that
+//! nearby smooth specular objects (glass, mirrors) subtend, so that light they focus onto it
+//! (a caustic) is found far more often than by cosine sampling alone.
+//!
+//! A caustic on a diffuse surface, the path diffuse - glass - glass - light, can only be
+//! found by sampling the BSDF: a light sample's shadow ray is stopped by the glass. Cosine
+//! sampling meets a small glass sphere rarely, and when it does the path carries the focused
+//! light's whole value, so the caustic is where such scenes keep their error (fireflies).
+//!
+//! At a vertex `p`, caster `k` (a bounding sphere) gets the weight
+//! `w_k = min(1, sin^2(theta_k) / NEAR)`, `theta_k` the half-angle of its cone seen from `p`
+//! (zero when `p` is inside it or the cone lies wholly below the horizon). The direction is
+//! drawn from the mixture
+//!
+//! `p_mix = (1 - a) p_bsdf + a sum_k (w_k / W) q_k`, with `W = sum_k w_k`, `a = SHARE min(1, W)`
+//!
+//! where `q_k` is the uniform density over cone `k`, and the sample is weighted by `p_mix`:
+//! the one-sample balance heuristic over the strategies (Veach 1997, section 9.2.4), so the
+//! estimate stays unbiased. The light sample's MIS weight and an emitter's weight when a
+//! path meets it use the same `p_mix`, so next-event estimation and the BSDF samples stay a
+//! partition of unity. A ball lens focuses within about its own radius and a convex mirror
+//! spreads what it reflects, so a caster's light is concentrated only near it: the weight
+//! falls with the square of the distance past twice the radius (`NEAR = 1/4`), and a vertex
+//! far from every caster samples its BSDF alone (docs/performance.md, "Aiming at casters").
+
+use crate::frame::Frame;
+use crate::material::Material;
+use core::f32::consts::TAU;
+use glam::{Mat4, Vec2, Vec3};
+use obscura_accel::{Placement, Shape};
+
+/// The largest share of a diffuse vertex's BSDF samples aimed at casters.
+pub(crate) const SHARE: f32 = 0.5;
+
+/// `sin^2` of a cone's half-angle from which a caster gets its full weight: within twice its
+/// radius of its centre.
+const NEAR: f32 = 0.25;
+
+/// The largest float below one: a rescaled number stays in `[0, 1)`.
+pub(crate) const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
+
+/// The most casters a scene keeps (the largest bounding spheres), so a vertex's cost stays
+/// bounded in a scene with many specular objects.
+pub(crate) const MAX_CASTERS: usize = 16;
+
+/// A caster's bounding sphere in world space.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Caster {
+    center: Vec3,
+    radius: f32,
+}
+
+/// The cone a caster subtends from a point outside it.
+#[derive(Debug, Clone, Copy)]
+struct Cone {
+    /// The unit direction to the caster's centre.
+    axis: Vec3,
+    /// `cos` of the half-angle.
+    cos_max: f32,
+    /// `1 - cos_max`, computed from `sin^2` without cancellation for small cones.
+    one_minus_cos_max: f32,
+}
+
+impl Cone {
+    /// The cone of `c` seen from `p`; `None` when `p` is inside (or on) the bounding sphere.
+    #[inline]
+    fn of(c: &Caster, p: Vec3) -> Option<Cone> {
+        let to_center = c.center - p;
+        let dc2 = to_center.length_squared();
+        let r2 = c.radius * c.radius;
+        if dc2 <= r2 * (1.0 + 1e-4) || !dc2.is_finite() {
+            return None;
+        }
+        let sin2_max = r2 / dc2;
+        let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
+        Some(Cone {
+            axis: to_center / dc2.sqrt(),
+            cos_max,
+            one_minus_cos_max: sin2_max / (1.0 + cos_max),
+        })
+    }
+
+    /// The uniform density over the cone, `1 / (2 pi (1 - cos_max))`.
+    #[inline]
+    fn pdf(&self) -> f32 {
+        1.0 / (TAU * self.one_minus_cos_max)
+    }
+
+    /// Whether the unit direction `w` lies in the cone.
+    #[inline]
+    fn contains(&self, w: Vec3) -> bool {
+        w.dot(self.axis) >= self.cos_max
+    }
+
+    /// A direction uniform over the cone (pbrt-v4's `SampleUniformCone`, with `cos` drawn
+    /// through `sin^2` so that small cones keep their precision).
+    #[inline]
+    fn sample(&self, u: Vec2) -> Vec3 {
+        let sin2 = u.x * self.one_minus_cos_max * (2.0 - u.x * self.one_minus_cos_max);
+        let cos_theta = (1.0 - sin2).max(0.0).sqrt();
+        let sin_theta = sin2.max(0.0).sqrt();
+        let (sin_phi, cos_phi) = (TAU * u.y).sin_cos();
+        Frame::from_normal(self.axis).from_local(Vec3::new(
+            sin_theta * cos_phi,
+            sin_theta * sin_phi,
+            cos_theta,
+        ))
+    }
+}
+
+/// The casters of a scene: the bounding spheres of its static instances whose material is
+/// smooth specular, at most [`MAX_CASTERS`] of them.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub(crate) struct Casters {
+    list: Vec<Caster>,
+}
+
+impl Casters {
+    /// The casters among `instances` (`(material, shape, placement)`): every static instance
+    /// whose material is all delta lobes ([`Material::is_specular`]), the largest
+    /// [`MAX_CASTERS`] by radius when there are more (ties by order). Moving instances are
+    /// left out: their bounding sphere changes over the shutter.
+    pub(crate) fn new<'a>(
+        instances: impl IntoIterator<Item = (&'a Material, &'a Shape, &'a Placement)>,
+    ) -> Casters {
+        let mut list: Vec<Caster> = instances
+            .into_iter()
+            .filter(|(m, _, _)| m.is_specular())
+            .filter_map(|(_, shape, placement)| match placement {
+                Placement::Static(t) => bounding_sphere(shape, &t.matrix()),
+                Placement::Moving(_) => None,
+            })
+            .collect();
+        if list.len() > MAX_CASTERS {
+            list.sort_by(|a, b| b.radius.total_cmp(&a.radius));
+            list.truncate(MAX_CASTERS);
+        }
+        Casters { list }
+    }
+
+    /// How many casters there are.
+    pub(crate) fn len(&self) -> usize {
+        self.list.len()
+    }
+
+    /// Whether there is any caster: without one, every vertex samples its BSDF alone.
+    #[inline]
+    pub(crate) fn is_empty(&self) -> bool {
+        self.list.is_empty()
+    }
+
+    /// The casters' cones and weights at `p`, for a vertex whose samples leave on the side
+    /// of the unit normal `n`.
+    #[inline]
+    pub(crate) fn at(&self, p: Vec3, n: Vec3) -> Aim {
+        let mut aim = Aim {
+            cones: [None; MAX_CASTERS],
+            count: self.list.len(),
+            total: 0.0,
+        };
+        for (slot, c) in aim.cones.iter_mut().zip(&self.list) {
+            let Some(cone) = Cone::of(c, p) else {
+                continue;
+            };
+            let sin2 = (1.0 - cone.cos_max * cone.cos_max).max(0.0);
+            // Wholly below the horizon: the angle from the normal to the axis exceeds 90
+            // degrees plus the half-angle.
+            if cone.axis.dot(n) < -sin2.sqrt() {
+                continue;
+            }
+            let weight = (sin2 / NEAR).min(1.0);
+            if weight > 0.0 {
+                aim.total += weight;
+                *slot = Some((cone, weight));
+            }
+        }
+        aim
+    }
+}
+
+/// The casters as one vertex sees them: each one's cone and weight (`None` for a caster it
+/// does not aim at), and the weights' sum.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Aim {
+    cones: [Option<(Cone, f32)>; MAX_CASTERS],
+    /// How many entries of `cones` are the scene's casters.
+    count: usize,
+    total: f32,
+}
+
+impl Aim {
+    /// The probability with which the vertex aims at a caster: `SHARE min(1, W)`.
+    #[inline]
+    pub(crate) fn share(&self) -> f32 {
+        SHARE * self.total.min(1.0)
+    }
+
+    /// A direction uniform over the cone of the caster that `u.x` picks (each by its weight;
+    /// `u.x` is then rescaled to `[0, 1)` within the pick), with the caster's index; `None`
+    /// when the vertex aims at none.
+    #[inline]
+    pub(crate) fn sample(&self, u: Vec2) -> Option<(Vec3, usize)> {
+        let mut target = u.x * self.total;
+        let mut last = None;
+        for (k, entry) in self.cones[..self.count].iter().enumerate() {
+            let Some((cone, weight)) = entry else {
+                continue;
+            };
+            last = Some((k, cone, *weight));
+            if target < *weight {
+                break;
+            }
+            target -= weight;
+        }
+        // Rounding may leave `target` just past the last weight: the last caster takes it.
+        let (k, cone, weight) = last?;
+        let x = (target / weight).clamp(0.0, ONE_MINUS_EPSILON);
+        Some((cone.sample(Vec2::new(x, u.y)), k))
+    }
+
+    /// The mixture's density for the world direction `w`, given the BSDF's own density
+    /// `pdf_bsdf` for it. `drawn`: the caster whose cone `w` was drawn from, if it was, which
+    /// counts as containing it whatever the rounding of the test says.
+    #[inline]
+    pub(crate) fn mixture_pdf(&self, w: Vec3, pdf_bsdf: f32, drawn: Option<usize>) -> f32 {
+        if self.total <= 0.0 {
+            return pdf_bsdf;
+        }
+        let mut aimed = 0.0;
+        for (k, entry) in self.cones[..self.count].iter().enumerate() {
+            if let Some((cone, weight)) = entry
+                && (drawn == Some(k) || cone.contains(w))
+            {
+                aimed += weight * cone.pdf();
+            }
+        }
+        let share = self.share();
+        (1.0 - share) * pdf_bsdf + share * aimed / self.total
+    }
+}
+
+/// A sphere around `shape` placed by `world_from_object`: exact for a sphere under a
+/// similarity, else the sphere through the corners of the world box around it.
+fn bounding_sphere(shape: &Shape, world_from_object: &Mat4) -> Option<Caster> {
+    let m = world_from_object;
+    let sphere_box;
+    let corners: &mut dyn Iterator<Item = Vec3> = match shape {
+        Shape::Sphere { center, radius } => {
+            let linear = glam::Mat3::from_mat4(*m);
+            let s = linear.x_axis.length();
+            let tol = 1e-4 * s;
+            let similar = (linear.y_axis.length() - s).abs() <= tol
+                && (linear.z_axis.length() - s).abs() <= tol
+                && linear.x_axis.dot(linear.y_axis).abs() <= tol * s
+                && linear.x_axis.dot(linear.z_axis).abs() <= tol * s
+                && linear.y_axis.dot(linear.z_axis).abs() <= tol * s;
+            if similar {
+                return finite(m.transform_point3(*center), radius * s);
+            }
+            sphere_box = box_corners(
+                *center - Vec3::splat(*radius),
+                *center + Vec3::splat(*radius),
+            );
+            &mut sphere_box.into_iter()
+        }
+        Shape::Quad {
+            origin,
+            edge_u,
+            edge_v,
+        } => &mut [
+            *origin,
+            *origin + *edge_u,
+            *origin + *edge_v,
+            *origin + *edge_u + *edge_v,
+        ]
+        .into_iter(),
+        Shape::Mesh(mesh) => &mut mesh.positions().iter().copied(),
+    };
+    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    for c in corners {
+        let w = m.transform_point3(c);
+        lo = lo.min(w);
+        hi = hi.max(w);
+    }
+    finite(0.5 * (lo + hi), 0.5 * (hi - lo).length())
+}
+
+/// The eight corners of the box `[lo, hi]`.
+fn box_corners(lo: Vec3, hi: Vec3) -> [Vec3; 8] {
+    std::array::from_fn(|i| {
+        Vec3::new(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        )
+    })
+}
+
+/// A caster, when its centre and radius are finite and the radius positive.
+fn finite(center: Vec3, radius: f32) -> Option<Caster> {
+    (center.is_finite() && radius.is_finite() && radius > 0.0).then_some(Caster { center, radius })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use core::f32::consts::PI;
+    use obscura_space::{AnimatedTransform, Transform};
+    use proptest::prelude::*;
+
+    fn casters(list: &[(Vec3, f32)]) -> Casters {
+        Casters {
+            list: list
+                .iter()
+                .map(|&(center, radius)| Caster { center, radius })
+                .collect(),
+        }
+    }
+
+    fn ball(radius: f32) -> Shape {
+        Shape::Sphere {
+            center: Vec3::ZERO,
+            radius,
+        }
+    }
+
+    fn at(x: f32, y: f32, z: f32) -> Placement {
+        Placement::Static(
+            Transform::from_matrix(Mat4::from_translation(Vec3::new(x, y, z))).unwrap(),
+        )
+    }
+
+    #[test]
+    fn only_static_specular_instances_cast() {
+        let glass = Material::Dielectric { ior: 1.5 };
+        let mirror = Material::Mirror {
+            reflectance: Vec3::ONE,
+        };
+        let clay = Material::Diffuse {
+            reflectance: Vec3::splat(0.5),
+        };
+        let rough = Material::RoughConductor {
+            reflectance: Vec3::ONE,
+            roughness: 0.5,
+        };
+        let moving = Placement::Moving(
+            AnimatedTransform::new(
+                Transform::IDENTITY,
+                0.0,
+                Transform::from_matrix(Mat4::from_translation(Vec3::X)).unwrap(),
+                1.0,
+            )
+            .unwrap(),
+        );
+        let (s, fixed) = (ball(1.0), at(0.0, 2.0, 0.0));
+        let c = Casters::new([
+            (&glass, &s, &fixed),
+            (&mirror, &s, &moving),
+            (&clay, &s, &fixed),
+            (&rough, &s, &fixed),
+        ]);
+        assert_eq!(
+            c.list,
+            vec![Caster {
+                center: Vec3::new(0.0, 2.0, 0.0),
+                radius: 1.0
+            }]
+        );
+    }
+
+    #[test]
+    fn bounding_spheres_by_hand() {
+        // A sphere of radius 1 at (1, 2, 3), scaled by 2 and moved by (1, 0, 0): centre
+        // (3, 4, 6), radius 2, exactly.
+        let m = Mat4::from_translation(Vec3::X) * Mat4::from_scale(Vec3::splat(2.0));
+        let s = Shape::Sphere {
+            center: Vec3::new(1.0, 2.0, 3.0),
+            radius: 1.0,
+        };
+        assert_eq!(
+            bounding_sphere(&s, &m),
+            Some(Caster {
+                center: Vec3::new(3.0, 4.0, 6.0),
+                radius: 2.0
+            })
+        );
+        // Stretched by 2 along y it is an ellipsoid: the sphere through its box's corners,
+        // [-1, 1] x [-2, 2] x [-1, 1], has radius sqrt(1 + 4 + 1).
+        let stretched = bounding_sphere(&ball(1.0), &Mat4::from_scale(Vec3::new(1.0, 2.0, 1.0)));
+        let c = stretched.unwrap();
+        assert_eq!(c.center, Vec3::ZERO);
+        assert!((c.radius - 6f32.sqrt()).abs() < 1e-6, "{c:?}");
+        // A 2 x 2 quad in the plane y = 0 from the origin: centre (1, 0, 1), radius sqrt(2).
+        let quad = Shape::Quad {
+            origin: Vec3::ZERO,
+            edge_u: Vec3::new(2.0, 0.0, 0.0),
+            edge_v: Vec3::new(0.0, 0.0, 2.0),
+        };
+        let c = bounding_sphere(&quad, &Mat4::IDENTITY).unwrap();
+        assert_eq!(c.center, Vec3::new(1.0, 0.0, 1.0));
+        assert!((c.radius - 2f32.sqrt()).abs() < 1e-6);
+        // A mesh's box: the triangle (0,0,0), (4,0,0), (0,2,0) has the box [0,4] x [0,2] x 0.
+        let mesh = obscura_accel::TriangleMesh::new(
+            vec![
+                Vec3::ZERO,
+                Vec3::new(4.0, 0.0, 0.0),
+                Vec3::new(0.0, 2.0, 0.0),
+            ],
+            vec![[0, 1, 2]],
+            None,
+            None,
+        )
+        .unwrap();
+        let c = bounding_sphere(&Shape::Mesh(std::sync::Arc::new(mesh)), &Mat4::IDENTITY).unwrap();
+        assert_eq!(c.center, Vec3::new(2.0, 1.0, 0.0));
+        assert!((c.radius - 5f32.sqrt()).abs() < 1e-6);
+    }
+
+    #[test]
+    fn more_casters_than_the_limit_keep_the_largest() {
+        let glass = Material::Dielectric { ior: 1.5 };
+        let shapes: Vec<Shape> = (0..MAX_CASTERS + 4).map(|k| ball(1.0 + k as f32)).collect();
+        let fixed = at(0.0, 0.0, 0.0);
+        let c = Casters::new(shapes.iter().map(|s| (&glass, s, &fixed)));
+        assert_eq!(c.len(), MAX_CASTERS);
+        assert!(c.list.iter().all(|c| c.radius >= 5.0), "{:?}", c.list);
+    }
+
+    #[test]
+    fn weights_and_shares_by_hand() {
+        let up = Vec3::Y;
+        // From 4 away a sphere of radius 1 has sin^2 = 1/16 of its half-angle: weight
+        // (1/16) / NEAR = 1/4, so a quarter of SHARE.
+        let far = casters(&[(Vec3::new(0.0, 4.0, 0.0), 1.0)]);
+        assert!((far.at(Vec3::ZERO, up).share() - SHARE / 4.0).abs() < 1e-6);
+        // From 1.5 away, sin^2 = 4/9 > NEAR: full weight.
+        let near = casters(&[(Vec3::new(0.0, 1.5, 0.0), 1.0)]);
+        assert_eq!(near.at(Vec3::ZERO, up).share(), SHARE);
+        // Two near casters: the share is still SHARE, split between them.
+        let two = casters(&[
+            (Vec3::new(0.0, 1.5, 0.0), 1.0),
+            (Vec3::new(1.5, 0.0, 0.0), 1.0),
+        ]);
+        assert_eq!(two.at(Vec3::ZERO, up).share(), SHARE);
+        // Wholly below the horizon (from the side of -y it is above), and from inside: none.
+        let below = casters(&[(Vec3::new(0.0, -4.0, 0.0), 1.0)]);
+        assert_eq!(below.at(Vec3::ZERO, up).share(), 0.0);
+        assert!((below.at(Vec3::ZERO, -up).share() - SHARE / 4.0).abs() < 1e-6);
+        assert_eq!(near.at(Vec3::new(0.0, 1.4, 0.0), up).share(), 0.0);
+        assert_eq!(
+            near.at(Vec3::new(0.0, 1.4, 0.0), up)
+                .sample(Vec2::splat(0.5)),
+            None
+        );
+        // Half below the horizon (the axis in the tangent plane) still counts.
+        let side = casters(&[(Vec3::new(4.0, 0.0, 0.0), 1.0)]);
+        assert!(side.at(Vec3::ZERO, up).share() > 0.0);
+    }
+
+    #[test]
+    fn picks_follow_the_weights() {
+        // Weights 1 (sin^2 = 4/9) and 1/4 (sin^2 = 1/16): picked 4/5 and 1/5 of the time over
+        // an even grid of u.x.
+        let c = casters(&[
+            (Vec3::new(0.0, 1.5, 0.0), 1.0),
+            (Vec3::new(4.0, 1.0, 0.0), 1.0),
+        ]);
+        let aim = c.at(Vec3::new(0.0, 0.0, 0.0), Vec3::Y);
+        let n = 10_000;
+        let mut picks = [0usize; 2];
+        for i in 0..n {
+            let (_, k) = aim
+                .sample(Vec2::new((i as f32 + 0.5) / n as f32, 0.3))
+                .unwrap();
+            picks[k] += 1;
+        }
+        let w2 = (1.0 / 17.0) / NEAR; // sin^2 from sqrt(17) away
+        let expected = 1.0 / (1.0 + w2);
+        assert!(
+            (picks[0] as f32 / n as f32 - expected).abs() < 2e-4,
+            "{picks:?}"
+        );
+    }
+
+    #[test]
+    fn the_mixture_density_integrates_to_one() {
+        // Over the whole sphere of directions, by the midpoint rule on a 1024 x 2048 grid in
+        // (cos theta, phi) (equal-area cells of 4 pi / N). A near cone, a far one, one half
+        // below the horizon and the cosine lobe: each part integrates to one, so the mixture
+        // does. The cones' edges cut cells, which costs at most about 1e-3 here.
+        let c = casters(&[
+            (Vec3::new(0.0, 1.5, 0.0), 1.0),
+            (Vec3::new(3.0, 2.0, 1.0), 0.7),
+            (Vec3::new(-3.0, 0.0, 0.0), 1.0),
+        ]);
+        let n = Vec3::Y;
+        let aim = c.at(Vec3::ZERO, n);
+        assert!(aim.share() > 0.0);
+        let (rows, cols) = (1024, 2048);
+        let mut sum = 0.0f64;
+        for i in 0..rows {
+            let z = 1.0 - 2.0 * (i as f32 + 0.5) / rows as f32;
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            for j in 0..cols {
+                let phi = 2.0 * PI * (j as f32 + 0.5) / cols as f32;
+                // The cosine lobe about n = +y.
+                let w = Vec3::new(r * phi.cos(), z, r * phi.sin());
+                let p_cos = w.y.max(0.0) / PI;
+                sum += aim.mixture_pdf(w, p_cos, None) as f64;
+            }
+        }
+        let integral = sum * 4.0 * PI as f64 / (rows * cols) as f64;
+        assert!((integral - 1.0).abs() < 3e-3, "{integral}");
+    }
+
+    proptest! {
+        #[test]
+        fn aimed_directions_lie_in_their_cone_with_a_density_at_least_their_own(
+            x in -3.0f32..3.0,
+            z in -3.0f32..3.0,
+            ux in 0.0f32..1.0,
+            uy in 0.0f32..1.0,
+        ) {
+            let c = casters(&[(Vec3::new(0.0, 2.0, 0.0), 1.0), (Vec3::new(2.0, 0.6, 1.0), 0.5)]);
+            let p = Vec3::new(x, 0.0, z);
+            let aim = c.at(p, Vec3::Y);
+            let Some((w, k)) = aim.sample(Vec2::new(ux, uy)) else {
+                return Ok(());
+            };
+            prop_assert!((w.length() - 1.0).abs() < 1e-5);
+            let cone = Cone::of(&c.list[k], p).unwrap();
+            prop_assert!(w.dot(cone.axis) >= cone.cos_max - 1e-5, "{w} {cone:?}");
+            let (_, weight) = aim.cones[k].unwrap();
+            let own = aim.share() * weight / aim.total * cone.pdf();
+            let pdf = aim.mixture_pdf(w, w.y.max(0.0) / PI, Some(k));
+            prop_assert!(pdf.is_finite() && pdf >= own * (1.0 - 1e-5), "{pdf} < {own}");
+        }
+    }
+}
