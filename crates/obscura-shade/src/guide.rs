@@ -7,10 +7,10 @@
 //! sampling meets a small glass sphere rarely, and when it does the path carries the focused
 //! light's whole value, so the caustic is where such scenes keep their error (fireflies).
 //!
-//! At a vertex `p`, caster `k` (a bounding sphere) gets the weight
-//! `w_k = min(1, sin^2(theta_k) / NEAR)`, `theta_k` the half-angle of its cone seen from `p`
-//! (zero when `p` is inside it or the cone lies wholly below the horizon). The direction is
-//! drawn from the mixture
+//! At a diffuse vertex `p` where the camera ray or the first bounce lands ([`AIMED_DEPTH`]),
+//! caster `k` (a bounding sphere) gets the weight `w_k = min(1, sin^2(theta_k) / NEAR)`,
+//! `theta_k` the half-angle of its cone seen from `p` (zero when `p` is inside it or the cone
+//! lies wholly below the horizon). The direction is drawn from the mixture
 //!
 //! `p_mix = (1 - a) p_bsdf + a sum_k (w_k / W) q_k`, with `W = sum_k w_k`, `a = SHARE min(1, W)`
 //!
@@ -36,12 +36,17 @@ pub(crate) const SHARE: f32 = 0.5;
 /// radius of its centre.
 const NEAR: f32 = 0.25;
 
+/// Vertices at path depths below this aim: where the camera ray and the first bounce land.
+/// A caustic seen after more diffuse bounces is blurred and dimmed by them, and aiming from
+/// every depth cost the Cornell-style box more time than it saved error.
+pub(crate) const AIMED_DEPTH: u32 = 2;
+
 /// The largest float below one: a rescaled number stays in `[0, 1)`.
 pub(crate) const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
 
 /// The most casters a scene keeps (the largest bounding spheres), so a vertex's cost stays
 /// bounded in a scene with many specular objects.
-pub(crate) const MAX_CASTERS: usize = 16;
+pub(crate) const MAX_CASTERS: usize = 8;
 
 /// A caster's bounding sphere in world space.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -55,43 +60,11 @@ struct Caster {
 struct Cone {
     /// The unit direction to the caster's centre.
     axis: Vec3,
-    /// `cos` of the half-angle.
-    cos_max: f32,
     /// `1 - cos_max`, computed from `sin^2` without cancellation for small cones.
     one_minus_cos_max: f32,
 }
 
 impl Cone {
-    /// The cone of `c` seen from `p`; `None` when `p` is inside (or on) the bounding sphere.
-    #[inline]
-    fn of(c: &Caster, p: Vec3) -> Option<Cone> {
-        let to_center = c.center - p;
-        let dc2 = to_center.length_squared();
-        let r2 = c.radius * c.radius;
-        if dc2 <= r2 * (1.0 + 1e-4) || !dc2.is_finite() {
-            return None;
-        }
-        let sin2_max = r2 / dc2;
-        let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
-        Some(Cone {
-            axis: to_center / dc2.sqrt(),
-            cos_max,
-            one_minus_cos_max: sin2_max / (1.0 + cos_max),
-        })
-    }
-
-    /// The uniform density over the cone, `1 / (2 pi (1 - cos_max))`.
-    #[inline]
-    fn pdf(&self) -> f32 {
-        1.0 / (TAU * self.one_minus_cos_max)
-    }
-
-    /// Whether the unit direction `w` lies in the cone.
-    #[inline]
-    fn contains(&self, w: Vec3) -> bool {
-        w.dot(self.axis) >= self.cos_max
-    }
-
     /// A direction uniform over the cone (pbrt-v4's `SampleUniformCone`, with `cos` drawn
     /// through `sin^2` so that small cones keep their precision).
     #[inline]
@@ -105,6 +78,48 @@ impl Cone {
             sin_theta * sin_phi,
             cos_theta,
         ))
+    }
+}
+
+/// A caster as a vertex sees it: enough to weigh it and to test a direction against its cone
+/// without a square root; the cone itself is made only for a sample drawn from it and for a
+/// density it contributes to.
+#[derive(Debug, Clone, Copy, Default)]
+struct Slot {
+    /// From the vertex to the caster's centre.
+    to_center: Vec3,
+    /// `|to_center|^2`.
+    d2: f32,
+    /// The caster's radius squared.
+    r2: f32,
+    /// `min(1, sin^2 / NEAR)`; zero for a caster the vertex does not aim at.
+    weight: f32,
+}
+
+impl Slot {
+    /// The cone of directions towards the caster.
+    #[inline]
+    fn cone(&self) -> Cone {
+        let sin2_max = self.r2 / self.d2;
+        let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
+        Cone {
+            axis: self.to_center / self.d2.sqrt(),
+            one_minus_cos_max: sin2_max / (1.0 + cos_max),
+        }
+    }
+
+    /// Whether the unit direction `w` lies in the cone: `w . axis >= cos_max`, squared
+    /// (`cos_max^2 d^2 = d^2 - r^2`).
+    #[inline]
+    fn contains(&self, w: Vec3) -> bool {
+        let t = w.dot(self.to_center);
+        t > 0.0 && t * t >= self.d2 - self.r2
+    }
+
+    /// The uniform density over the cone, `1 / (2 pi (1 - cos_max))`.
+    #[inline]
+    fn pdf(&self) -> f32 {
+        1.0 / (TAU * self.cone().one_minus_cos_max)
     }
 }
 
@@ -149,41 +164,43 @@ impl Casters {
         self.list.is_empty()
     }
 
-    /// The casters' cones and weights at `p`, for a vertex whose samples leave on the side
-    /// of the unit normal `n`.
+    /// The casters' weights at `p`, for a vertex whose samples leave on the side of the unit
+    /// normal `n`: zero from inside a caster's bounding sphere and for a cone wholly below
+    /// the horizon (the angle from `n` to its axis beyond 90 degrees plus its half-angle,
+    /// that is `(c - p) . n < -r`).
     #[inline]
     pub(crate) fn at(&self, p: Vec3, n: Vec3) -> Aim {
         let mut aim = Aim {
-            cones: [None; MAX_CASTERS],
+            slots: [Slot::default(); MAX_CASTERS],
             count: self.list.len(),
             total: 0.0,
         };
-        for (slot, c) in aim.cones.iter_mut().zip(&self.list) {
-            let Some(cone) = Cone::of(c, p) else {
+        for (slot, c) in aim.slots.iter_mut().zip(&self.list) {
+            let to_center = c.center - p;
+            let d2 = to_center.length_squared();
+            let r2 = c.radius * c.radius;
+            let outside = d2 > r2 * (1.0 + 1e-4) && d2.is_finite();
+            if !outside || to_center.dot(n) < -c.radius {
                 continue;
+            }
+            let weight = (r2 / (NEAR * d2)).min(1.0);
+            *slot = Slot {
+                to_center,
+                d2,
+                r2,
+                weight,
             };
-            let sin2 = (1.0 - cone.cos_max * cone.cos_max).max(0.0);
-            // Wholly below the horizon: the angle from the normal to the axis exceeds 90
-            // degrees plus the half-angle.
-            if cone.axis.dot(n) < -sin2.sqrt() {
-                continue;
-            }
-            let weight = (sin2 / NEAR).min(1.0);
-            if weight > 0.0 {
-                aim.total += weight;
-                *slot = Some((cone, weight));
-            }
+            aim.total += weight;
         }
         aim
     }
 }
 
-/// The casters as one vertex sees them: each one's cone and weight (`None` for a caster it
-/// does not aim at), and the weights' sum.
+/// The casters as one vertex sees them (slot `k` for caster `k`), and their weights' sum.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Aim {
-    cones: [Option<(Cone, f32)>; MAX_CASTERS],
-    /// How many entries of `cones` are the scene's casters.
+    slots: [Slot; MAX_CASTERS],
+    /// How many slots are the scene's casters.
     count: usize,
     total: f32,
 }
@@ -202,20 +219,20 @@ impl Aim {
     pub(crate) fn sample(&self, u: Vec2) -> Option<(Vec3, usize)> {
         let mut target = u.x * self.total;
         let mut last = None;
-        for (k, entry) in self.cones[..self.count].iter().enumerate() {
-            let Some((cone, weight)) = entry else {
+        for (k, slot) in self.slots[..self.count].iter().enumerate() {
+            if slot.weight <= 0.0 {
                 continue;
-            };
-            last = Some((k, cone, *weight));
-            if target < *weight {
+            }
+            last = Some((k, slot));
+            if target < slot.weight {
                 break;
             }
-            target -= weight;
+            target -= slot.weight;
         }
         // Rounding may leave `target` just past the last weight: the last caster takes it.
-        let (k, cone, weight) = last?;
-        let x = (target / weight).clamp(0.0, ONE_MINUS_EPSILON);
-        Some((cone.sample(Vec2::new(x, u.y)), k))
+        let (k, slot) = last?;
+        let x = (target / slot.weight).clamp(0.0, ONE_MINUS_EPSILON);
+        Some((slot.cone().sample(Vec2::new(x, u.y)), k))
     }
 
     /// The mixture's density for the world direction `w`, given the BSDF's own density
@@ -227,11 +244,9 @@ impl Aim {
             return pdf_bsdf;
         }
         let mut aimed = 0.0;
-        for (k, entry) in self.cones[..self.count].iter().enumerate() {
-            if let Some((cone, weight)) = entry
-                && (drawn == Some(k) || cone.contains(w))
-            {
-                aimed += weight * cone.pdf();
+        for (k, slot) in self.slots[..self.count].iter().enumerate() {
+            if slot.weight > 0.0 && (drawn == Some(k) || slot.contains(w)) {
+                aimed += slot.weight * slot.pdf();
             }
         }
         let share = self.share();
@@ -528,10 +543,10 @@ mod tests {
                 return Ok(());
             };
             prop_assert!((w.length() - 1.0).abs() < 1e-5);
-            let cone = Cone::of(&c.list[k], p).unwrap();
-            prop_assert!(w.dot(cone.axis) >= cone.cos_max - 1e-5, "{w} {cone:?}");
-            let (_, weight) = aim.cones[k].unwrap();
-            let own = aim.share() * weight / aim.total * cone.pdf();
+            let slot = aim.slots[k];
+            let cone = slot.cone();
+            prop_assert!(w.dot(cone.axis) >= 1.0 - cone.one_minus_cos_max - 1e-5, "{w} {cone:?}");
+            let own = aim.share() * slot.weight / aim.total * slot.pdf();
             let pdf = aim.mixture_pdf(w, w.y.max(0.0) / PI, Some(k));
             prop_assert!(pdf.is_finite() && pdf >= own * (1.0 - 1e-5), "{pdf} < {own}");
         }

@@ -3,7 +3,7 @@
 
 use crate::error::ShadeError;
 use crate::frame::Frame;
-use crate::guide::{Aim, Casters, ONE_MINUS_EPSILON};
+use crate::guide::{self, Aim, Casters, ONE_MINUS_EPSILON};
 use crate::light::{AreaLight, Light};
 use crate::material::{BsdfSample, Material};
 use glam::{Vec2, Vec3};
@@ -158,7 +158,7 @@ impl ShadingScene {
         })
     }
 
-    /// Makes diffuse vertices aim half of their BSDF samples at the smooth specular objects
+    /// Makes diffuse vertices aim up to half of their BSDF samples at the smooth specular objects
     /// among `instances` (`(instance, shape, placement)`, instances numbered as for
     /// [`ShadingScene::new`]): the static ones whose material is all delta lobes (glass,
     /// mirrors), each by the cone its bounding sphere subtends. Caustics, light focused by such
@@ -264,7 +264,10 @@ pub fn power_heuristic(pdf_a: f32, pdf_b: f32) -> f32 {
 /// environment only, 1 direct lighting, and so on. Russian roulette starts after
 /// [`PathIntegrator::RR_START_DEPTH`] bounces, with survival probability
 /// [`rr_survival`]: the largest channel of the path throughput with the refractions'
-/// `1 / eta^2` radiance scaling undone, clamped to `[0.05, 1]`.
+/// `1 / eta^2` radiance scaling undone, clamped to `[0.05, 1]`. In a scene whose shading
+/// side has casters ([`ShadingScene::aim_at_specular`]), a diffuse vertex where the camera ray
+/// or the first bounce lands draws its BSDF sample from a mixture of the cosine lobe and the
+/// cones of the glass and mirrors near it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct PathIntegrator {
     /// The largest number of bounces.
@@ -525,8 +528,9 @@ impl PathIntegrator {
             return (None, false);
         }
 
-        // A diffuse vertex in a scene with casters aims part of its samples at them.
-        let aim = aims(shading, material).then(|| {
+        // A diffuse vertex of a path's first bounces, in a scene with casters, aims part of
+        // its samples at them.
+        let aim = (path.depth < guide::AIMED_DEPTH && aims(shading, material)).then(|| {
             let n = if wo.z < 0.0 { -frame.n } else { frame.n };
             shading.casters.at(hit.p.to_glam(), n)
         });

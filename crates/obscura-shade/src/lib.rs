@@ -17,7 +17,9 @@
 //!   its random numbers from any [`SampleDims`], such as `obscura_sample::SampleStream`.
 //!   [`PathIntegrator::li_and_hit_batch`] traces many camera rays' paths together, a vertex
 //!   each per round, so that their rays reach the geometry in batches (faster on large
-//!   meshes, the same values bit for bit).
+//!   meshes, the same values bit for bit). After [`ShadingScene::aim_at_specular`], diffuse
+//!   vertices aim a share of their samples at the nearby glass and mirrors, so that the
+//!   caustics those throw are found far more often (still unbiased).
 //!
 //! What is not here: geometry and ray queries (obscura-accel), cameras, films, scene files and
 //! image output (obscura-camera, obscura-render). Nothing here owns a random number generator.
