@@ -24,10 +24,12 @@
 //! far from every caster samples its BSDF alone (docs/performance.md, "Aiming at casters").
 
 use crate::frame::Frame;
+use crate::light::solid_angle::world_sphere;
 use crate::material::Material;
 use core::f32::consts::TAU;
-use glam::{Mat4, Vec2, Vec3};
+use glam::{Vec2, Vec3};
 use obscura_accel::{Placement, Shape};
+use obscura_space::{Object, Transform, World};
 
 /// The largest share of a diffuse vertex's BSDF samples aimed at casters.
 pub(crate) const SHARE: f32 = 0.5;
@@ -142,7 +144,7 @@ impl Casters {
             .into_iter()
             .filter(|(m, _, _)| m.is_specular())
             .filter_map(|(_, shape, placement)| match placement {
-                Placement::Static(t) => bounding_sphere(shape, &t.matrix()),
+                Placement::Static(t) => bounding_sphere(shape, t),
                 Placement::Moving(_) => None,
             })
             .collect();
@@ -256,21 +258,13 @@ impl Aim {
 
 /// A sphere around `shape` placed by `world_from_object`: exact for a sphere under a
 /// similarity, else the sphere through the corners of the world box around it.
-fn bounding_sphere(shape: &Shape, world_from_object: &Mat4) -> Option<Caster> {
-    let m = world_from_object;
+fn bounding_sphere(shape: &Shape, world_from_object: &Transform<World, Object>) -> Option<Caster> {
+    let m = &world_from_object.matrix();
     let sphere_box;
     let corners: &mut dyn Iterator<Item = Vec3> = match shape {
         Shape::Sphere { center, radius } => {
-            let linear = glam::Mat3::from_mat4(*m);
-            let s = linear.x_axis.length();
-            let tol = 1e-4 * s;
-            let similar = (linear.y_axis.length() - s).abs() <= tol
-                && (linear.z_axis.length() - s).abs() <= tol
-                && linear.x_axis.dot(linear.y_axis).abs() <= tol * s
-                && linear.x_axis.dot(linear.z_axis).abs() <= tol * s
-                && linear.y_axis.dot(linear.z_axis).abs() <= tol * s;
-            if similar {
-                return finite(m.transform_point3(*center), radius * s);
+            if let Some((c, r)) = world_sphere(world_from_object, *center, *radius) {
+                return finite(c, r);
             }
             sphere_box = box_corners(
                 *center - Vec3::splat(*radius),
@@ -320,7 +314,8 @@ fn finite(center: Vec3, radius: f32) -> Option<Caster> {
 mod tests {
     use super::*;
     use core::f32::consts::PI;
-    use obscura_space::{AnimatedTransform, Transform};
+    use glam::Mat4;
+    use obscura_space::AnimatedTransform;
     use proptest::prelude::*;
 
     fn casters(list: &[(Vec3, f32)]) -> Casters {
@@ -387,7 +382,8 @@ mod tests {
     fn bounding_spheres_by_hand() {
         // A sphere of radius 1 at (1, 2, 3), scaled by 2 and moved by (1, 0, 0): centre
         // (3, 4, 6), radius 2, exactly.
-        let m = Mat4::from_translation(Vec3::X) * Mat4::from_scale(Vec3::splat(2.0));
+        let t = |m: Mat4| Transform::from_matrix(m).unwrap();
+        let m = t(Mat4::from_translation(Vec3::X) * Mat4::from_scale(Vec3::splat(2.0)));
         let s = Shape::Sphere {
             center: Vec3::new(1.0, 2.0, 3.0),
             radius: 1.0,
@@ -401,7 +397,7 @@ mod tests {
         );
         // Stretched by 2 along y it is an ellipsoid: the sphere through its box's corners,
         // [-1, 1] x [-2, 2] x [-1, 1], has radius sqrt(1 + 4 + 1).
-        let stretched = bounding_sphere(&ball(1.0), &Mat4::from_scale(Vec3::new(1.0, 2.0, 1.0)));
+        let stretched = bounding_sphere(&ball(1.0), &t(Mat4::from_scale(Vec3::new(1.0, 2.0, 1.0))));
         let c = stretched.unwrap();
         assert_eq!(c.center, Vec3::ZERO);
         assert!((c.radius - 6f32.sqrt()).abs() < 1e-6, "{c:?}");
@@ -411,7 +407,7 @@ mod tests {
             edge_u: Vec3::new(2.0, 0.0, 0.0),
             edge_v: Vec3::new(0.0, 0.0, 2.0),
         };
-        let c = bounding_sphere(&quad, &Mat4::IDENTITY).unwrap();
+        let c = bounding_sphere(&quad, &Transform::IDENTITY).unwrap();
         assert_eq!(c.center, Vec3::new(1.0, 0.0, 1.0));
         assert!((c.radius - 2f32.sqrt()).abs() < 1e-6);
         // A mesh's box: the triangle (0,0,0), (4,0,0), (0,2,0) has the box [0,4] x [0,2] x 0.
@@ -426,7 +422,11 @@ mod tests {
             None,
         )
         .unwrap();
-        let c = bounding_sphere(&Shape::Mesh(std::sync::Arc::new(mesh)), &Mat4::IDENTITY).unwrap();
+        let c = bounding_sphere(
+            &Shape::Mesh(std::sync::Arc::new(mesh)),
+            &Transform::IDENTITY,
+        )
+        .unwrap();
         assert_eq!(c.center, Vec3::new(2.0, 1.0, 0.0));
         assert!((c.radius - 5f32.sqrt()).abs() < 1e-6);
     }

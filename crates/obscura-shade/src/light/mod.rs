@@ -4,7 +4,7 @@
 
 mod area;
 mod environment;
-mod solid_angle;
+pub(crate) mod solid_angle;
 
 pub use area::AreaLight;
 pub use environment::{EnvironmentLight, direction_to_uv, uv_to_direction};

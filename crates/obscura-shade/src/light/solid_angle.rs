@@ -30,7 +30,7 @@ pub(super) fn area_to_solid_angle(pdf_area: f32, p_ref: Vec3, p_light: Vec3, n_l
 
 /// The world centre and radius of an object-space sphere when the map is a similarity
 /// (rotation, uniform scale, translation); `None` when it would be an ellipsoid.
-pub(super) fn world_sphere(
+pub(crate) fn world_sphere(
     world_from_object: &Transform<World, Object>,
     center: Vec3,
     radius: f32,
