@@ -315,45 +315,32 @@ fn orthographic_spheres_keep_their_size_with_distance() {
 
 #[test]
 fn images_are_identical_for_one_and_two_threads() {
-    let d = aov(
-        shipped("spheres-motion-blur.toml"),
-        IntegratorKind::Path,
-        [48, 32],
-        4,
-    );
-    let one = render_image(d.clone(), 1);
-    let two = render_image(d, 2);
-    assert!(
-        one.pixels
-            .iter()
-            .zip(&two.pixels)
-            .all(|(a, b)| a.map(f32::to_bits) == b.map(f32::to_bits))
-    );
+    // The motion-blurred spheres, and the Cornell box, whose diffuse vertices aim at its
+    // mirror and glass spheres (aimed samples go through the batched and one-path loops).
+    for (scene, resolution) in [
+        ("spheres-motion-blur.toml", [48, 32]),
+        ("cornell-box.toml", [40, 40]),
+    ] {
+        let d = aov(shipped(scene), IntegratorKind::Path, resolution, 4);
+        let one = render_image(d.clone(), 1);
+        let two = render_image(d, 2);
+        assert!(
+            one.pixels
+                .iter()
+                .zip(&two.pixels)
+                .all(|(a, b)| a.map(f32::to_bits) == b.map(f32::to_bits)),
+            "{scene}"
+        );
+    }
 }
 
 #[test]
-fn the_cornell_box_aims_at_its_mirror_and_glass_and_renders_the_same_on_any_thread_count() {
+fn the_renderer_aims_at_the_cornell_box_mirror_and_glass() {
     // The renderer hands every instance to the shading scene, which keeps the static
-    // specular ones as casters for diffuse vertices to aim at: here the mirror and the glass
-    // sphere. Aimed samples go through the batched and one-path loops alike, so the image
-    // is bit-identical on one and two threads.
-    let d = aov(
-        shipped("cornell-box.toml"),
-        IntegratorKind::Path,
-        [40, 40],
-        4,
-    );
-    let scene = RenderScene::build(d.clone()).unwrap();
+    // specular ones as casters for diffuse vertices to aim at: the mirror and the glass
+    // sphere here; the spheres-only scenes have none.
+    let scene = RenderScene::build(shipped("cornell-box.toml")).unwrap();
     assert_eq!(scene.shading.caster_count(), 2);
-    let one = render_image(d.clone(), 1);
-    let two = render_image(d, 2);
-    assert!(
-        one.pixels
-            .iter()
-            .zip(&two.pixels)
-            .all(|(a, b)| a.map(f32::to_bits) == b.map(f32::to_bits))
-    );
-    // The spheres-only scenes have no specular object: nothing to aim at.
     let plain = RenderScene::build(shipped("spheres-perspective.toml")).unwrap();
     assert_eq!(plain.shading.caster_count(), 0);
 }
