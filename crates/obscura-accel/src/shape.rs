@@ -3,7 +3,7 @@
 
 use crate::mesh::TriangleMesh;
 use glam::Vec3;
-use obscura_space::{AnimatedTransform, Object, Transform, World};
+use obscura_space::{AnimatedTransform, Bounds3, Object, Point3, Transform, World};
 use std::sync::Arc;
 
 /// A shape in its own object space.
@@ -28,6 +28,32 @@ pub enum Shape {
         /// The second edge from `origin`.
         edge_v: Vec3,
     },
+}
+
+impl Shape {
+    /// The box around the shape in its own object space.
+    pub fn object_bounds(&self) -> Bounds3<Object> {
+        match self {
+            Shape::Mesh(mesh) => mesh.bounds(),
+            Shape::Sphere { center, radius } => Bounds3::new(
+                Point3::from_glam(*center - Vec3::splat(*radius)),
+                Point3::from_glam(*center + Vec3::splat(*radius)),
+            ),
+            Shape::Quad {
+                origin,
+                edge_u,
+                edge_v,
+            } => Bounds3::from_points(
+                [
+                    *origin,
+                    *origin + *edge_u,
+                    *origin + *edge_v,
+                    *origin + *edge_u + *edge_v,
+                ]
+                .map(Point3::from_glam),
+            ),
+        }
+    }
 }
 
 /// Where an instance sits in the world.

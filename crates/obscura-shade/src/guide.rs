@@ -24,11 +24,12 @@
 //! far from every caster samples its BSDF alone (docs/performance.md, "Aiming at casters").
 
 use crate::frame::Frame;
-use crate::light::solid_angle::world_sphere;
+use crate::light::solid_angle::{cone_pdf, cone_sin2, one_minus_cos, world_sphere};
 use crate::material::Material;
 use core::f32::consts::TAU;
 use glam::{Vec2, Vec3};
 use obscura_accel::{Placement, Shape};
+use obscura_sample::ONE_MINUS_EPSILON;
 use obscura_space::{Object, Transform, World};
 
 /// The largest share of a diffuse vertex's BSDF samples aimed at casters.
@@ -42,9 +43,6 @@ const NEAR: f32 = 0.25;
 /// A caustic seen after more diffuse bounces is blurred and dimmed by them, and aiming from
 /// every depth cost the Cornell-style box more time than it saved error.
 pub(crate) const AIMED_DEPTH: u32 = 2;
-
-/// The largest float below one: a rescaled number stays in `[0, 1)`.
-pub(crate) const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
 
 /// The most casters a scene keeps (the largest bounding spheres), so a vertex's cost stays
 /// bounded in a scene with many specular objects.
@@ -67,11 +65,10 @@ struct Cone {
 }
 
 impl Cone {
-    /// A direction uniform over the cone (pbrt-v4's `SampleUniformCone`, with `cos` drawn
-    /// through `sin^2` so that small cones keep their precision).
+    /// A direction uniform over the cone ([`cone_sin2`] for the angle from the axis).
     #[inline]
     fn sample(&self, u: Vec2) -> Vec3 {
-        let sin2 = u.x * self.one_minus_cos_max * (2.0 - u.x * self.one_minus_cos_max);
+        let sin2 = cone_sin2(u.x, self.one_minus_cos_max);
         let cos_theta = (1.0 - sin2).max(0.0).sqrt();
         let sin_theta = sin2.max(0.0).sqrt();
         let (sin_phi, cos_phi) = (TAU * u.y).sin_cos();
@@ -102,11 +99,9 @@ impl Slot {
     /// The cone of directions towards the caster.
     #[inline]
     fn cone(&self) -> Cone {
-        let sin2_max = self.r2 / self.d2;
-        let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
         Cone {
             axis: self.to_center / self.d2.sqrt(),
-            one_minus_cos_max: sin2_max / (1.0 + cos_max),
+            one_minus_cos_max: one_minus_cos(self.r2 / self.d2),
         }
     }
 
@@ -118,10 +113,10 @@ impl Slot {
         t > 0.0 && t * t >= self.d2 - self.r2
     }
 
-    /// The uniform density over the cone, `1 / (2 pi (1 - cos_max))`.
+    /// The uniform density over the cone.
     #[inline]
     fn pdf(&self) -> f32 {
-        1.0 / (TAU * self.cone().one_minus_cos_max)
+        cone_pdf(self.r2 / self.d2)
     }
 }
 
@@ -257,52 +252,18 @@ impl Aim {
 }
 
 /// A sphere around `shape` placed by `world_from_object`: exact for a sphere under a
-/// similarity, else the sphere through the corners of the world box around it.
+/// similarity, else the sphere through the corners of the world box around its object box.
 fn bounding_sphere(shape: &Shape, world_from_object: &Transform<World, Object>) -> Option<Caster> {
-    let m = &world_from_object.matrix();
-    let sphere_box;
-    let corners: &mut dyn Iterator<Item = Vec3> = match shape {
-        Shape::Sphere { center, radius } => {
-            if let Some((c, r)) = world_sphere(world_from_object, *center, *radius) {
-                return finite(c, r);
-            }
-            sphere_box = box_corners(
-                *center - Vec3::splat(*radius),
-                *center + Vec3::splat(*radius),
-            );
-            &mut sphere_box.into_iter()
-        }
-        Shape::Quad {
-            origin,
-            edge_u,
-            edge_v,
-        } => &mut [
-            *origin,
-            *origin + *edge_u,
-            *origin + *edge_v,
-            *origin + *edge_u + *edge_v,
-        ]
-        .into_iter(),
-        Shape::Mesh(mesh) => &mut mesh.positions().iter().copied(),
-    };
-    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-    for c in corners {
-        let w = m.transform_point3(c);
-        lo = lo.min(w);
-        hi = hi.max(w);
+    if let Shape::Sphere { center, radius } = shape
+        && let Some((c, r)) = world_sphere(world_from_object, *center, *radius)
+    {
+        return finite(c, r);
     }
-    finite(0.5 * (lo + hi), 0.5 * (hi - lo).length())
-}
-
-/// The eight corners of the box `[lo, hi]`.
-fn box_corners(lo: Vec3, hi: Vec3) -> [Vec3; 8] {
-    std::array::from_fn(|i| {
-        Vec3::new(
-            if i & 1 == 0 { lo.x } else { hi.x },
-            if i & 2 == 0 { lo.y } else { hi.y },
-            if i & 4 == 0 { lo.z } else { hi.z },
-        )
-    })
+    let b = world_from_object.bounds(shape.object_bounds());
+    finite(
+        b.centroid().to_glam(),
+        0.5 * b.diagonal().to_glam().length(),
+    )
 }
 
 /// A caster, when its centre and radius are finite and the radius positive.

@@ -3,12 +3,12 @@
 
 use crate::error::ShadeError;
 use crate::frame::Frame;
-use crate::guide::{self, Aim, Casters, ONE_MINUS_EPSILON};
+use crate::guide::{self, Aim, Casters};
 use crate::light::{AreaLight, Light};
 use crate::material::{BsdfSample, Material};
 use glam::{Vec2, Vec3};
 use obscura_accel::{Hit, Placement, Scene, Shape};
-use obscura_sample::{SampleStream, SearchStart};
+use obscura_sample::{ONE_MINUS_EPSILON, SampleStream, SearchStart};
 use obscura_space::{Ray, Vector3, World};
 
 /// The canonical numbers a path consumes, one shading decision after another. Implemented by

@@ -124,26 +124,7 @@ impl SceneBuilder {
         // Every coordinate the BVH and the intersection tests see must stay far from f32's
         // overflow: products of two coordinates (cross products, squared distances) must be
         // finite, or bounds turn infinite and the BVH build and hit tests break down.
-        let object_bounds = match &shape {
-            Shape::Mesh(mesh) => mesh.bounds(),
-            Shape::Sphere { center, radius } => Bounds3::new(
-                Point3::from_glam(*center - Vec3::splat(*radius)),
-                Point3::from_glam(*center + Vec3::splat(*radius)),
-            ),
-            Shape::Quad {
-                origin,
-                edge_u,
-                edge_v,
-            } => Bounds3::from_points(
-                [
-                    *origin,
-                    *origin + *edge_u,
-                    *origin + *edge_v,
-                    *origin + *edge_u + *edge_v,
-                ]
-                .map(Point3::from_glam),
-            ),
-        };
+        let object_bounds = shape.object_bounds();
         let world_bounds = match &placement {
             Placement::Static(t) => t.bounds(object_bounds),
             Placement::Moving(a) => a.motion_bounds(object_bounds),

@@ -1,7 +1,8 @@
 //! The area light: any emissive shape of obscura-accel, at its instance's placement.
 
 use super::solid_angle::{
-    area_to_solid_angle, cone_pdf, normal_matrix, orientation_sign, world_sphere,
+    area_to_solid_angle, cone_pdf, cone_sin2, normal_matrix, one_minus_cos, orientation_sign,
+    world_sphere,
 };
 use super::{LightSample, TINY};
 use crate::error::{ShadeError, check_non_negative};
@@ -287,9 +288,7 @@ impl AreaLight {
         let w_c = to_center / dc;
         // Sample cos(theta) uniformly in [cos_max, 1]; small cones via sin^2 to keep precision.
         let sin2_max = r2 / dc2;
-        let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
-        let one_minus_cos_max = sin2_max / (1.0 + cos_max);
-        let sin2_theta = u2.x * one_minus_cos_max * (2.0 - u2.x * one_minus_cos_max);
+        let sin2_theta = cone_sin2(u2.x, one_minus_cos(sin2_max));
         let cos_theta = (1.0 - sin2_theta).max(0.0).sqrt();
         // The point on the sphere seen at that angle: the nearer intersection of the ray.
         let ds = dc * cos_theta - (r2 - dc2 * sin2_theta).max(0.0).sqrt();

@@ -6,12 +6,24 @@ use core::f32::consts::TAU;
 use glam::{Mat3, Mat4, Vec3};
 use obscura_space::{Object, Transform, World};
 
+/// `1 - cos` of a cone's half-angle from its `sin^2`, without cancellation for small cones.
+pub(crate) fn one_minus_cos(sin2_max: f32) -> f32 {
+    let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
+    sin2_max / (1.0 + cos_max)
+}
+
 /// The density of uniform cone sampling, `1 / (2 pi (1 - cos_max))`, from `sin^2` of the
 /// half-angle, computed without cancellation for small cones.
-pub(super) fn cone_pdf(sin2_max: f32) -> f32 {
-    let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
-    let one_minus_cos_max = sin2_max / (1.0 + cos_max);
-    1.0 / (TAU * one_minus_cos_max)
+pub(crate) fn cone_pdf(sin2_max: f32) -> f32 {
+    1.0 / (TAU * one_minus_cos(sin2_max))
+}
+
+/// `sin^2` of the angle from the axis of a direction uniform over the cone with
+/// `1 - cos_max` = `one_minus_cos_max`, for a uniform `u`: `cos` uniform in `[cos_max, 1]`,
+/// drawn through `sin^2` so that small cones keep their precision (pbrt-v4's
+/// `SampleUniformCone`).
+pub(crate) fn cone_sin2(u: f32, one_minus_cos_max: f32) -> f32 {
+    u * one_minus_cos_max * (2.0 - u * one_minus_cos_max)
 }
 
 /// Converts an area density at `p_light` (normal `n_light`) to solid angle seen from `p_ref`.

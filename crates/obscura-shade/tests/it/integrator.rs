@@ -59,6 +59,24 @@ fn build_aiming(
     (builder.build().unwrap(), shading)
 }
 
+/// The red channel of `n` paths along `r`, each checked finite and non-negative.
+fn path_values(
+    integrator: &PathIntegrator,
+    scene: &(Scene, ShadingScene),
+    r: &Ray<World>,
+    n: usize,
+    seed: u64,
+) -> Vec<f64> {
+    let mut rng = Rng::new(seed);
+    (0..n)
+        .map(|_| {
+            let l = integrator.li(&scene.0, &scene.1, r, &mut rng);
+            assert!(l.is_finite() && l.min_element() >= 0.0, "{l}");
+            l.x as f64
+        })
+        .collect()
+}
+
 fn estimate(
     integrator: &PathIntegrator,
     scene: &(Scene, ShadingScene),
@@ -66,15 +84,7 @@ fn estimate(
     n: usize,
     seed: u64,
 ) -> (f64, f64) {
-    let mut rng = Rng::new(seed);
-    let values: Vec<f64> = (0..n)
-        .map(|_| {
-            let l = integrator.li(&scene.0, &scene.1, r, &mut rng);
-            assert!(l.is_finite() && l.min_element() >= 0.0, "{l}");
-            l.x as f64
-        })
-        .collect();
-    mean_and_error(&values)
+    mean_and_error(&path_values(integrator, scene, r, n, seed))
 }
 
 fn white() -> Material {
@@ -839,10 +849,7 @@ fn estimate_and_count(
     n: usize,
     seed: u64,
 ) -> (f64, f64, usize) {
-    let mut rng = Rng::new(seed);
-    let values: Vec<f64> = (0..n)
-        .map(|_| PathIntegrator::new(8).li(&scene.0, &scene.1, r, &mut rng).x as f64)
-        .collect();
+    let values = path_values(&PathIntegrator::new(8), scene, r, n, seed);
     let (m, e) = mean_and_error(&values);
     (m, e, values.iter().filter(|&&v| v > 0.0).count())
 }
