@@ -267,7 +267,8 @@ pub fn power_heuristic(pdf_a: f32, pdf_b: f32) -> f32 {
 /// `1 / eta^2` radiance scaling undone, clamped to `[0.05, 1]`. In a scene whose shading
 /// side has casters ([`ShadingScene::aim_at_specular`]), a diffuse vertex where the camera ray
 /// or the first bounce lands draws its BSDF sample from a mixture of the cosine lobe and the
-/// cones of the glass and mirrors near it.
+/// cones of the glass and mirrors near it; roulette sees such a sample's throughput as the
+/// BSDF's own density would have weighted it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct PathIntegrator {
     /// The largest number of bounces.
@@ -275,11 +276,12 @@ pub struct PathIntegrator {
 }
 
 /// Which values the path tracer gives for the same scene and random numbers: raised whenever
-/// its estimator changes (1 before diffuse vertices aimed at casters, 2 since). Films made by
+/// its estimator changes (1 before diffuse vertices aimed at casters, 2 once they did, 3 since
+/// Russian roulette sees an aimed sample's throughput without the aim's weight). Films made by
 /// a build with another estimator are unbiased but not this build's image, so the renderer's
 /// scene fingerprint includes this number, as it includes the samplers'
 /// `obscura_sample::SEQUENCE_VERSION`.
-pub const ESTIMATOR_VERSION: u32 = 2;
+pub const ESTIMATOR_VERSION: u32 = 3;
 
 /// Densities below this are treated as zero (the path ends instead of dividing by them).
 const MIN_PDF: f32 = 1e-12;
@@ -569,11 +571,12 @@ impl PathIntegrator {
         // Only a material with a choice of lobes reads `u` (see Material::reads_lobe_choice).
         let u = dims.next_1d_if(material.reads_lobe_choice());
         let u2 = dims.next_2d();
+        // `own_pdf`: the BSDF's own density for the direction, where the mixture's differs.
         let sampled = match &aim {
             Some(aim) => sample_aimed(aim, material, &frame, wo, u2),
-            None => material.sample(wo, u, u2),
+            None => material.sample(wo, u, u2).map(|bs| (bs, bs.pdf)),
         };
-        let Some(bs) = sampled else {
+        let Some((bs, own_pdf)) = sampled else {
             return (shadow, false);
         };
         if bs.pdf < MIN_PDF || bs.f == Vec3::ZERO {
@@ -593,10 +596,15 @@ impl PathIntegrator {
         path.ray = spawn_ray(&hit, wi_world);
         path.depth += 1;
 
-        path.eta_scale *= bs.eta * bs.eta;
+        // Roulette sees the throughput without a refraction's 1 / eta^2 and without an aimed
+        // vertex's weight `p_own / p_mix`: a sample aimed at glass carries a small weight because
+        // it was drawn often, not because little light comes that way, and ending such paths
+        // by their small weight would undo the aiming for every caustic met past the start.
+        let aim_scale = if own_pdf > 0.0 { bs.pdf / own_pdf } else { 1.0 };
+        path.rr_scale *= bs.eta * bs.eta * aim_scale;
         // Russian roulette once the path is a few bounces long.
         if path.depth >= Self::RR_START_DEPTH {
-            let survive = rr_survival(path.beta, path.eta_scale);
+            let survive = rr_survival(path.beta, path.rr_scale);
             if dims.next_1d() >= survive {
                 return (shadow, false);
             }
@@ -701,7 +709,8 @@ fn aims(shading: &ShadingScene, material: &Material) -> bool {
 
 /// A direction from the mixture of the BSDF's sampling and the casters' cones (the first
 /// [`Aim::share`] of `u2.x`'s range aims at a caster, the rest samples the BSDF, each with
-/// the number rescaled to `[0, 1)`), with the mixture's density as its `pdf`.
+/// the number rescaled to `[0, 1)`), with the mixture's density as its `pdf`, and the BSDF's
+/// own density for the same direction.
 #[inline]
 fn sample_aimed(
     aim: &Aim,
@@ -709,7 +718,7 @@ fn sample_aimed(
     frame: &Frame,
     wo: Vec3,
     u2: Vec2,
-) -> Option<BsdfSample> {
+) -> Option<(BsdfSample, f32)> {
     let share = aim.share();
     let rescale = |x: f32, lo: f32, width: f32| ((x - lo) / width).clamp(0.0, ONE_MINUS_EPSILON);
     let aimed = if u2.x < share {
@@ -735,10 +744,11 @@ fn sample_aimed(
             (bs, frame.from_local(bs.wi), None)
         }
     };
-    Some(BsdfSample {
+    let mixed = BsdfSample {
         pdf: aim.mixture_pdf(w, bs.pdf, drawn),
         ..bs
-    })
+    };
+    Some((mixed, bs.pdf))
 }
 
 /// What a round's prefetch sweep found for a path's coming vertex, which the vertex then
@@ -808,9 +818,10 @@ struct PathState {
     prev_pdf: f32,
     prev_p: Vec3,
     depth: u32,
-    /// The product of eta^2 over the refractions so far: beta * eta_scale is the path's
-    /// throughput without the 1 / eta^2 radiance scaling, which Russian roulette must not see.
-    eta_scale: f32,
+    /// The product of eta^2 over the refractions so far and of `p_mix / p_own` over the aimed
+    /// vertices: beta * rr_scale is the path's throughput without the 1 / eta^2 radiance
+    /// scaling and the aims' weights, which Russian roulette must not see.
+    rr_scale: f32,
     camera_ray_hit: bool,
 }
 
@@ -828,7 +839,7 @@ impl PathState {
             prev_pdf: 0.0,
             prev_p: ray.origin.to_glam(),
             depth: 0,
-            eta_scale: 1.0,
+            rr_scale: 1.0,
             camera_ray_hit: false,
         })
     }
@@ -854,13 +865,14 @@ struct Shadow {
 }
 
 /// Russian roulette's survival probability for a path of throughput `beta` whose refractions
-/// multiplied its radiance by `1 / eta_scale`: the largest channel of `beta * eta_scale`,
-/// clamped to `[0.05, 1]`. Without `eta_scale` a path inside glass (radiance scaled by
+/// and aimed samples scaled it by `1 / scale`: the largest channel of `beta * scale`, clamped
+/// to `[0.05, 1]`. Without the refractions' eta^2 a path inside glass (radiance scaled by
 /// 1 / 1.5^2) would be ended 56% more often and its survivors weighted up, the variance of
 /// every caustic and every view through glass; pbrt-v4 and Mitsuba 3 roulette on the same
-/// product. The floor bounds the weight a survivor can gain at 20.
-pub fn rr_survival(beta: Vec3, eta_scale: f32) -> f32 {
-    let q = beta.max_element() * eta_scale;
+/// product. An aimed sample's `p_mix / p_own` does the same for the aiming at casters. The
+/// floor bounds the weight a survivor can gain at 20.
+pub fn rr_survival(beta: Vec3, scale: f32) -> f32 {
+    let q = beta.max_element() * scale;
     if q.is_nan() { 0.05 } else { q.clamp(0.05, 1.0) }
 }
 
