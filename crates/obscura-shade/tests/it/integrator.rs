@@ -877,11 +877,19 @@ fn aiming_at_glass_finds_its_caustic_more_often_with_the_same_mean() {
     // = 2.6 times as many caustic paths. Measured 2.7; the counts (about 800 and 2100 of
     // 40,000) are binomial, so fewer than twice as many would be six standard deviations out.
     // Both estimates are unbiased: they must agree within 4.5 combined standard errors.
+    aiming_finds_the_caustic_more_often(10.0, &[2.5], 40_000, 3);
+}
+
+/// Paths from the side onto the floor under the balls of `caustic_scene(floor_half,
+/// heights)`, `n` plain and `n` aimed (seeds `seed` and `seed + 1`): the aimed ones must
+/// carry light at least twice as often, and both estimates must agree within 4.5 combined
+/// standard errors.
+fn aiming_finds_the_caustic_more_often(floor_half: f32, heights: &[f32], n: usize, seed: u64) {
     let r = ray(Vec3::new(4.0, 0.4, 0.0), Vec3::new(-4.0, -0.4, 0.05), 0.0);
     let (plain, plain_err, plain_lit) =
-        estimate_and_count(&caustic_scene(10.0, &[2.5], false), &r, 40_000, 3);
+        estimate_and_count(&caustic_scene(floor_half, heights, false), &r, n, seed);
     let (aimed, aimed_err, aimed_lit) =
-        estimate_and_count(&caustic_scene(10.0, &[2.5], true), &r, 40_000, 4);
+        estimate_and_count(&caustic_scene(floor_half, heights, true), &r, n, seed + 1);
     let report = format!(
         "plain {plain} +- {plain_err} ({plain_lit} lit), aimed {aimed} +- {aimed_err} ({aimed_lit} lit)"
     );
@@ -906,16 +914,5 @@ fn roulette_past_the_start_keeps_what_aiming_found() {
     // many: 1979 against 499 of 200,000). The counts are binomial; twice the plain count lies
     // over ten standard deviations from both.
     assert_eq!(PathIntegrator::RR_START_DEPTH, 5);
-    let r = ray(Vec3::new(4.0, 0.4, 0.0), Vec3::new(-4.0, -0.4, 0.05), 0.0);
-    let (plain, plain_err, plain_lit) =
-        estimate_and_count(&caustic_scene(0.25, &[2.5, 5.0], false), &r, 200_000, 5);
-    let (aimed, aimed_err, aimed_lit) =
-        estimate_and_count(&caustic_scene(0.25, &[2.5, 5.0], true), &r, 200_000, 6);
-    let report = format!(
-        "plain {plain} +- {plain_err} ({plain_lit} lit), aimed {aimed} +- {aimed_err} ({aimed_lit} lit)"
-    );
-    assert!(plain_lit > 300, "{report}");
-    assert!(aimed_lit > 2 * plain_lit, "{report}");
-    let combined = (plain_err * plain_err + aimed_err * aimed_err).sqrt();
-    assert!((plain - aimed).abs() <= 4.5 * combined, "{report}");
+    aiming_finds_the_caustic_more_often(0.25, &[2.5, 5.0], 200_000, 5);
 }
