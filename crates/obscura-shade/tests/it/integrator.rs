@@ -655,13 +655,41 @@ fn roulette_sees_through_the_radiance_scaling_of_glass() {
 #[test]
 fn roulette_survival_hand_values() {
     use obscura_shade::rr_survival;
-    // The largest channel of beta * eta_scale, clamped to [0.05, 1].
+    // The largest channel of beta * scale, clamped to [0.05, 1].
     assert_eq!(rr_survival(Vec3::new(0.2, 0.4, 0.1), 1.0), 0.4);
     assert!((rr_survival(Vec3::splat(0.4), 2.25) - 0.9).abs() < 1e-6);
     assert_eq!(rr_survival(Vec3::splat(0.5), 2.25), 1.0);
     assert_eq!(rr_survival(Vec3::splat(0.001), 1.0), 0.05);
     assert_eq!(rr_survival(Vec3::splat(f32::NAN), 1.0), 0.05);
     assert_eq!(rr_survival(Vec3::splat(f32::INFINITY), 1.0), 1.0);
+    // An aimed sample's throughput 0.31 with its scale p_mix / p_own = 2.6 (the two-ball
+    // caustic test's case): roulette sees 0.806, a cosine sample's 0.8 within rounding.
+    assert!((rr_survival(Vec3::splat(0.31), 2.6) - 0.806).abs() < 1e-6);
+    // A path that carries nothing under a scale that overflowed: 0 x inf is NaN, the floor.
+    assert_eq!(rr_survival(Vec3::ZERO, f32::INFINITY), 0.05);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(500))]
+
+    /// Survival is a probability that roulette can divide by, for any throughput and scale
+    /// (refractions' eta^2 and aims' density ratios span many decades), and it is the
+    /// largest channel of `beta * scale` wherever that lies in `[0.05, 1]`.
+    #[test]
+    fn roulette_survival_is_a_probability(
+        b in prop::array::uniform3(0.0f32..1e3),
+        log_scale in -30.0f32..30.0,
+    ) {
+        use obscura_shade::rr_survival;
+        let beta = Vec3::from(b);
+        let scale = 10f32.powf(log_scale);
+        let q = rr_survival(beta, scale);
+        prop_assert!((0.05..=1.0).contains(&q), "{q}");
+        let raw = beta.max_element() * scale;
+        if (0.05..=1.0).contains(&raw) {
+            prop_assert_eq!(q, raw);
+        }
+    }
 }
 
 /// A floor of `n` x `n` quads, two triangles each, rippled so that rays meet it at every angle.
