@@ -571,12 +571,11 @@ impl PathIntegrator {
         // Only a material with a choice of lobes reads `u` (see Material::reads_lobe_choice).
         let u = dims.next_1d_if(material.reads_lobe_choice());
         let u2 = dims.next_2d();
-        // `own_pdf`: the BSDF's own density for the direction, where the mixture's differs.
         let sampled = match &aim {
             Some(aim) => sample_aimed(aim, material, &frame, wo, u2),
-            None => material.sample(wo, u, u2).map(|bs| (bs, bs.pdf)),
+            None => material.sample(wo, u, u2).map(|bs| (bs, 1.0)),
         };
-        let Some((bs, own_pdf)) = sampled else {
+        let Some((bs, aim_scale)) = sampled else {
             return (shadow, false);
         };
         if bs.pdf < MIN_PDF || bs.f == Vec3::ZERO {
@@ -600,7 +599,6 @@ impl PathIntegrator {
         // vertex's weight `p_own / p_mix`: a sample aimed at glass carries a small weight because
         // it was drawn often, not because little light comes that way, and ending such paths
         // by their small weight would undo the aiming for every caustic met past the start.
-        let aim_scale = if own_pdf > 0.0 { bs.pdf / own_pdf } else { 1.0 };
         path.rr_scale *= bs.eta * bs.eta * aim_scale;
         // Russian roulette once the path is a few bounces long.
         if path.depth >= Self::RR_START_DEPTH {
@@ -709,8 +707,9 @@ fn aims(shading: &ShadingScene, material: &Material) -> bool {
 
 /// A direction from the mixture of the BSDF's sampling and the casters' cones (the first
 /// [`Aim::share`] of `u2.x`'s range aims at a caster, the rest samples the BSDF, each with
-/// the number rescaled to `[0, 1)`), with the mixture's density as its `pdf`, and the BSDF's
-/// own density for the same direction.
+/// the number rescaled to `[0, 1)`), with the mixture's density as its `pdf`, and the factor
+/// `p_mix / p_own` by which that density exceeds the BSDF's own (1 where the BSDF gives the
+/// direction no density), which Russian roulette undoes.
 #[inline]
 fn sample_aimed(
     aim: &Aim,
@@ -744,11 +743,9 @@ fn sample_aimed(
             (bs, frame.from_local(bs.wi), None)
         }
     };
-    let mixed = BsdfSample {
-        pdf: aim.mixture_pdf(w, bs.pdf, drawn),
-        ..bs
-    };
-    Some((mixed, bs.pdf))
+    let pdf = aim.mixture_pdf(w, bs.pdf, drawn);
+    let scale = if bs.pdf > 0.0 { pdf / bs.pdf } else { 1.0 };
+    Some((BsdfSample { pdf, ..bs }, scale))
 }
 
 /// What a round's prefetch sweep found for a path's coming vertex, which the vertex then
