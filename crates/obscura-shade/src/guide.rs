@@ -30,7 +30,7 @@ use core::f32::consts::TAU;
 use glam::{Vec2, Vec3};
 use obscura_accel::{Placement, Shape};
 use obscura_sample::ONE_MINUS_EPSILON;
-use obscura_space::{Object, Transform, World};
+use obscura_space::{AnimatedTransform, Bounds3, Object, Point3, Transform, World};
 
 /// The largest share of a diffuse vertex's BSDF samples aimed at casters.
 pub(crate) const SHARE: f32 = 0.5;
@@ -120,18 +120,19 @@ impl Slot {
     }
 }
 
-/// The casters of a scene: the bounding spheres of its static instances whose material is
-/// smooth specular, at most [`MAX_CASTERS`] of them.
+/// The casters of a scene: the bounding spheres of its instances whose material is smooth
+/// specular, at most [`MAX_CASTERS`] of them.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub(crate) struct Casters {
     list: Vec<Caster>,
 }
 
 impl Casters {
-    /// The casters among `instances` (`(material, shape, placement)`): every static instance
-    /// whose material is all delta lobes ([`Material::is_specular`]), the largest
-    /// [`MAX_CASTERS`] by radius when there are more (ties by order). Moving instances are
-    /// left out: their bounding sphere changes over the shutter.
+    /// The casters among `instances` (`(material, shape, placement)`): every instance whose
+    /// material is all delta lobes ([`Material::is_specular`]), the largest [`MAX_CASTERS`]
+    /// by radius when there are more (ties by order). A moving instance is bounded over its
+    /// whole motion ([`AnimatedTransform::motion_bounds`]): a vertex cannot know where along
+    /// it a later ray will meet the object, and any sphere keeps the estimate unbiased.
     pub(crate) fn new<'a>(
         instances: impl IntoIterator<Item = (&'a Material, &'a Shape, &'a Placement)>,
     ) -> Casters {
@@ -140,7 +141,7 @@ impl Casters {
             .filter(|(m, _, _)| m.is_specular())
             .filter_map(|(_, shape, placement)| match placement {
                 Placement::Static(t) => bounding_sphere(shape, t),
-                Placement::Moving(_) => None,
+                Placement::Moving(a) => swept_sphere(shape, a),
             })
             .collect();
         if list.len() > MAX_CASTERS {
@@ -266,6 +267,35 @@ fn bounding_sphere(shape: &Shape, world_from_object: &Transform<World, Object>) 
     )
 }
 
+/// A sphere that holds `shape` over all of its motion. For a sphere placed by similarities at
+/// every keyframe: the box its centre sweeps, grown by the largest of the keyframes' radii (a
+/// uniform scale is interpolated linearly between keyframes, so the radius never exceeds
+/// them). Otherwise the sphere through the corners of the box the shape sweeps.
+fn swept_sphere(
+    shape: &Shape,
+    world_from_object: &AnimatedTransform<World, Object>,
+) -> Option<Caster> {
+    if let Shape::Sphere { center, radius } = shape {
+        let radii: Option<Vec<f32>> = world_from_object
+            .keyframes()
+            .map(|(_, t)| world_sphere(&t, *center, *radius).map(|(_, r)| r))
+            .collect();
+        if let Some(largest) = radii.and_then(|r| r.into_iter().reduce(f32::max)) {
+            let c = Point3::from_glam(*center);
+            let path = world_from_object.motion_bounds(Bounds3::new(c, c));
+            return finite(
+                path.centroid().to_glam(),
+                0.5 * path.diagonal().to_glam().length() + largest,
+            );
+        }
+    }
+    let b = world_from_object.motion_bounds(shape.object_bounds());
+    finite(
+        b.centroid().to_glam(),
+        0.5 * b.diagonal().to_glam().length(),
+    )
+}
+
 /// A caster, when its centre and radius are finite and the radius positive.
 fn finite(center: Vec3, radius: f32) -> Option<Caster> {
     (center.is_finite() && radius.is_finite() && radius > 0.0).then_some(Caster { center, radius })
@@ -276,7 +306,6 @@ mod tests {
     use super::*;
     use core::f32::consts::PI;
     use glam::Mat4;
-    use obscura_space::AnimatedTransform;
     use proptest::prelude::*;
 
     fn casters(list: &[(Vec3, f32)]) -> Casters {
@@ -302,7 +331,7 @@ mod tests {
     }
 
     #[test]
-    fn only_static_specular_instances_cast() {
+    fn specular_instances_cast_and_moving_ones_over_their_motion() {
         let glass = Material::Dielectric { ior: 1.5 };
         let mirror = Material::Mirror {
             reflectance: Vec3::ONE,
@@ -314,29 +343,51 @@ mod tests {
             reflectance: Vec3::ONE,
             roughness: 0.5,
         };
-        let moving = Placement::Moving(
-            AnimatedTransform::new(
-                Transform::IDENTITY,
-                0.0,
-                Transform::from_matrix(Mat4::from_translation(Vec3::X)).unwrap(),
-                1.0,
-            )
-            .unwrap(),
-        );
+        let t = |m: Mat4| Transform::from_matrix(m).unwrap();
+        let slide = |from: Mat4, to: Mat4| {
+            Placement::Moving(AnimatedTransform::new(t(from), 0.0, t(to), 1.0).unwrap())
+        };
+        let moving = slide(Mat4::IDENTITY, Mat4::from_translation(Vec3::X));
         let (s, fixed) = (ball(1.0), at(0.0, 2.0, 0.0));
         let c = Casters::new([
             (&glass, &s, &fixed),
             (&mirror, &s, &moving),
             (&clay, &s, &fixed),
             (&rough, &s, &fixed),
+            (&clay, &s, &moving),
         ]);
+        assert_eq!(c.len(), 2, "{:?}", c.list);
         assert_eq!(
-            c.list,
-            vec![Caster {
+            c.list[0],
+            Caster {
                 center: Vec3::new(0.0, 2.0, 0.0),
                 radius: 1.0
-            }]
+            }
         );
+        // The unit ball slid by 1 along x: its centre sweeps (0, 0, 0) to (1, 0, 0), so the
+        // sphere is centred at (0.5, 0, 0) with radius 0.5 + 1.
+        let swept = |placement: &Placement| Casters::new([(&glass, &s, placement)]).list[0];
+        let c = swept(&moving);
+        assert!(
+            (c.center - Vec3::new(0.5, 0.0, 0.0)).length() < 1e-6,
+            "{c:?}"
+        );
+        assert!((c.radius - 1.5).abs() < 1e-6, "{c:?}");
+        // Growing from radius 1 to 2 in place: the larger radius.
+        let c = swept(&slide(Mat4::IDENTITY, Mat4::from_scale(Vec3::splat(2.0))));
+        assert!(
+            c.center.length() < 1e-6 && (c.radius - 2.0).abs() < 1e-6,
+            "{c:?}"
+        );
+        // Stretched by 2 along y (not a sphere) and slid by 1 along x: the box it sweeps is
+        // [-1, 2] x [-2, 2] x [-1, 1], whose corners lie sqrt(9 + 16 + 4) / 2 from its centre.
+        let stretch = Mat4::from_scale(Vec3::new(1.0, 2.0, 1.0));
+        let c = swept(&slide(stretch, Mat4::from_translation(Vec3::X) * stretch));
+        assert!(
+            (c.center - Vec3::new(0.5, 0.0, 0.0)).length() < 1e-6,
+            "{c:?}"
+        );
+        assert!((c.radius - 29f32.sqrt() / 2.0).abs() < 1e-5, "{c:?}");
     }
 
     #[test]

@@ -160,9 +160,10 @@ impl ShadingScene {
 
     /// Makes diffuse vertices aim up to half of their BSDF samples at the smooth specular objects
     /// among `instances` (`(instance, shape, placement)`, instances numbered as for
-    /// [`ShadingScene::new`]): the static ones whose material is all delta lobes (glass,
-    /// mirrors), each by the cone its bounding sphere subtends. Caustics, light focused by such
-    /// an object onto a diffuse surface, are then found far more often; the estimate stays
+    /// [`ShadingScene::new`]): those whose material is all delta lobes (glass, mirrors), each
+    /// by the cone its bounding sphere subtends (a moving one's sphere holds it over its whole
+    /// motion). Caustics, light focused by such an object onto a diffuse surface, are then
+    /// found far more often; the estimate stays
     /// unbiased (the samples are weighted by the mixture's density). Instances with an unknown
     /// number are ignored. Without this call no sample is aimed.
     pub fn aim_at_specular<'a>(
@@ -277,11 +278,12 @@ pub struct PathIntegrator {
 
 /// Which values the path tracer gives for the same scene and random numbers: raised whenever
 /// its estimator changes (1 before diffuse vertices aimed at casters, 2 once they did, 3 since
-/// Russian roulette sees an aimed sample's throughput without the aim's weight). Films made by
+/// Russian roulette sees an aimed sample's throughput without the aim's weight, 4 since moving
+/// glass and mirrors are aimed at too). Films made by
 /// a build with another estimator are unbiased but not this build's image, so the renderer's
 /// scene fingerprint includes this number, as it includes the samplers'
 /// `obscura_sample::SEQUENCE_VERSION`.
-pub const ESTIMATOR_VERSION: u32 = 3;
+pub const ESTIMATOR_VERSION: u32 = 4;
 
 /// Densities below this are treated as zero (the path ends instead of dividing by them).
 const MIN_PDF: f32 = 1e-12;
