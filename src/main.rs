@@ -462,17 +462,23 @@ fn run_render(args: RenderArgs) -> Result<ExitCode, RenderError> {
             );
             return Ok(ExitCode::from(status));
         }
+        let partial_path = partial_image_path(&output);
         write_image(
-            &output,
+            &partial_path,
             &outcome.film.resolve(),
             &ImageInfo {
                 partial: true,
                 samples_per_pixel: outcome.passes_done,
             },
         )?;
+        let kept = if partial_path == output {
+            String::new()
+        } else {
+            format!(", beside the older {}, left as it was", output.display())
+        };
         eprintln!(
-            "interrupted: wrote partial image {} ({} of {spp} samples per pixel){}",
-            output.display(),
+            "interrupted: wrote partial image {}{kept} ({} of {spp} samples per pixel){}",
+            partial_path.display(),
             outcome.passes_done,
             args.checkpoint
                 .as_ref()
@@ -518,6 +524,20 @@ fn run_render(args: RenderArgs) -> Result<ExitCode, RenderError> {
     }
     println!("{summary}");
     Ok(ExitCode::SUCCESS)
+}
+
+/// Where an interrupted render writes its partial image: the output path when nothing is there,
+/// else `NAME.partial.EXT` beside it, so that an older image is never replaced by a partial one.
+fn partial_image_path(output: &Path) -> PathBuf {
+    if std::fs::symlink_metadata(output).is_err() {
+        return output.to_path_buf();
+    }
+    let stem = output.file_stem().unwrap_or_default().to_string_lossy();
+    let name = match output.extension() {
+        Some(ext) => format!("{stem}.partial.{}", ext.to_string_lossy()),
+        None => format!("{stem}.partial"),
+    };
+    output.with_file_name(name)
 }
 
 /// Reads the scene file's bytes, for the fingerprint of checkpoints and partials.

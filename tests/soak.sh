@@ -8,7 +8,8 @@
 # each run (0 to 200 ms after it starts, before or after its signal handlers are installed)
 # and resuming from the checkpoint every time, until CYCLES interrupts have landed; then lets
 # it finish. The final image must equal the straight one bit for bit and the folder must hold
-# no temporary or partial file. Exits 0 on success, 1 with a message otherwise.
+# no temporary file (the interrupted runs' partial images are out.exr's first, then
+# out.partial.exr beside it). Exits 0 on success, 1 with a message otherwise.
 set -euo pipefail
 # Job control: without it bash starts background jobs with SIGINT ignored, and an interrupt
 # that lands before the render installs its handler would be lost.
@@ -58,7 +59,7 @@ if ! cmp -s "$dir/out.exr" "$dir/straight.exr"; then
     echo "FAIL: the resumed image differs from the straight render" >&2
     exit 1
 fi
-left=$(ls "$dir" | grep -v -x -e out.exr -e soak.ckpt -e straight.exr || true)
+left=$(ls "$dir" | grep -v -x -e out.exr -e out.partial.exr -e soak.ckpt -e straight.exr || true)
 if [ -n "$left" ]; then
     echo "FAIL: files left behind: $left" >&2
     exit 1

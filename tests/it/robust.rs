@@ -87,7 +87,7 @@ pub(super) fn names_in(dir: &Path) -> Vec<String> {
 }
 
 #[test]
-fn sigint_writes_the_partial_image_and_exits_130() {
+fn sigint_writes_the_partial_image_beside_the_older_one_and_exits_130() {
     let dir = scratch("sigint");
     let output = dir.join("out.exr");
     std::fs::write(&output, b"an older image").unwrap();
@@ -97,11 +97,13 @@ fn sigint_writes_the_partial_image_and_exits_130() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(130), "{stderr}");
     assert!(
-        stderr.contains("interrupted: wrote partial image") && stderr.contains("out.exr"),
+        stderr.contains("interrupted: wrote partial image") && stderr.contains("out.partial.exr"),
         "{stderr}"
     );
-    // The partial image replaced the older file, flagged partial in its header.
-    let (image, partial) = read_exr(&output).unwrap();
+    // The older image is kept (SCENE_FORMAT.md: an interrupted render never destroys an older
+    // one); the partial image is beside it, flagged partial in its header.
+    assert_eq!(std::fs::read(&output).unwrap(), b"an older image");
+    let (image, partial) = read_exr(&dir.join("out.partial.exr")).unwrap();
     assert!(partial);
     assert_eq!((image.width, image.height), (24, 16));
     // It holds exactly the passes of the checkpoint saved on the way out.
@@ -113,11 +115,11 @@ fn sigint_writes_the_partial_image_and_exits_130() {
         "{stderr}"
     );
     // Nothing else was left in the folder (no temporary files).
-    assert_eq!(names_in(&dir), ["long.ckpt", "out.exr"]);
+    assert_eq!(names_in(&dir), ["long.ckpt", "out.exr", "out.partial.exr"]);
 }
 
 #[test]
-fn sigterm_also_writes_the_partial_image_and_exits_143() {
+fn sigterm_writes_the_partial_image_where_nothing_was_and_exits_143() {
     let dir = scratch("sigterm");
     let output = dir.join("out.png");
     let (child, _) = start_long_render(&dir, &output);
@@ -126,8 +128,10 @@ fn sigterm_also_writes_the_partial_image_and_exits_143() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(143), "{stderr}");
     assert!(stderr.contains("partial image"), "{stderr}");
+    // No older image was there, so the partial one takes the output's own name.
     let png = image::open(&output).unwrap();
     assert_eq!((png.width(), png.height()), (24, 16));
+    assert_eq!(names_in(&dir), ["long.ckpt", "out.png"]);
 }
 
 /// Whether `/proc/PID/stat` says the process is stopped.
