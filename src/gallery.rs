@@ -61,7 +61,7 @@ macro_rules! figure {
 }
 
 /// Every figure the gallery makes, in order.
-pub const FIGURES: [Figure; 24] = [
+pub const FIGURES: [Figure; 25] = [
     figure!("projection-perspective"),
     figure!("projection-orthographic"),
     figure!("dof-lens-radius"),
@@ -84,6 +84,7 @@ pub const FIGURES: [Figure; 24] = [
     figure!("lens-shift"),
     figure!("realistic-lenses"),
     figure!("aperture-bokeh"),
+    figure!("realistic-apertures"),
     figure!("rolling-shutter"),
     figure!("tilt-shift"),
 ];
@@ -190,8 +191,8 @@ fn make_figure(out_dir: &Path, figure: Figure, quality: Quality) -> Result<Made,
             source,
         })?;
     }
-    // The realistic figure's lens files go beside it too, where its lens_file finds them.
-    if figure.name == "realistic-lenses" {
+    // The realistic figures' lens files go beside them too, where their lens_file finds them.
+    if figure.name.starts_with("realistic-") {
         let dir = out_dir.join("lenses");
         let io = |file: PathBuf| {
             move |source| RenderError::Io {
@@ -316,8 +317,9 @@ fn make_figure(out_dir: &Path, figure: Figure, quality: Quality) -> Result<Made,
                 shoot(d)
             })
             .collect::<Result<_, _>>()?,
-        "aperture-bokeh" => {
-            // The panels' apertures are constants, valid by construction.
+        "aperture-bokeh" | "realistic-apertures" => {
+            // The panels' apertures are constants, valid by construction. The lens system's
+            // stop takes the aperture as the thin lens does.
             let with = |aperture: Aperture| {
                 let mut d = base.clone();
                 d.camera.lens.aperture = aperture;

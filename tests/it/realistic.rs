@@ -2,7 +2,7 @@
 //! the places `project` gives, and a uniform sky renders as 1 at the image centre.
 
 use super::{aov, render_image, root, shipped};
-use obscura_camera::{Camera, LensPrescription};
+use obscura_camera::{AnyCamera, Camera, LensPrescription};
 use obscura_render::{
     FilterSettings, Image, IntegratorKind, LightSettings, RenderScene, SceneDescription,
 };
@@ -88,4 +88,35 @@ fn a_uniform_sky_renders_as_one_at_the_centre_and_darker_in_the_corners() {
             "{lens}: corner {corner} vs centre {centre}"
         );
     }
+}
+
+#[test]
+fn the_stop_takes_the_aperture_keys_of_the_scene_file() {
+    // `anamorphic` and `aperture_blades` on a realistic camera reach its stop (they were once
+    // noted as ignored), and the image centre of a uniform sky still renders as 1: the
+    // normaliser counts the squeezed stop's smaller opening.
+    let path = root().join("scenes").join("spheres-realistic.toml");
+    let text = std::fs::read_to_string(&path).unwrap().replace(
+        "film_diagonal = 35.0",
+        "film_diagonal = 35.0\nanamorphic = 2.0\naperture_blades = 6",
+    );
+    let mut d = obscura_render::parse_description(&path, &text).unwrap();
+    assert!(d.ignored.is_empty(), "{:?}", d.ignored);
+    let scene = RenderScene::build(d.clone()).unwrap();
+    let AnyCamera::Realistic(camera) = &scene.camera else {
+        panic!("not a realistic camera");
+    };
+    assert_eq!(camera.lens().aperture.anamorphic, 2.0);
+    assert_eq!(camera.lens().aperture.blades(), 6);
+
+    d = aov(d, IntegratorKind::Path, [9, 9], 4096);
+    d.film.filter = FilterSettings::Box { radius: 0.5 };
+    d.shapes.clear();
+    d.lights = vec![LightSettings::Environment {
+        radiance: [1.0, 1.0, 1.0],
+        file: None,
+        transform: Transform::<World, World>::IDENTITY,
+    }];
+    let centre = pixel(&render_image(d, 2), 4, 4)[0];
+    assert!((centre - 1.0).abs() < 0.05, "centre {centre}");
 }

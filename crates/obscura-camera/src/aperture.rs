@@ -1,6 +1,7 @@
-//! The aperture: the shape a lens sample is warped onto. One owner for every lens model (the
-//! thin lens now, a lens system's stop later): round, a regular polygon of blades, or an image
-//! of weights, each optionally squeezed by an anamorphic factor.
+//! The aperture: the shape a lens sample is warped onto, or that passes a lens system's rays.
+//! One owner for every lens model (the thin lens, and the stop of a lens system): round, a
+//! regular polygon of blades, or an image of weights, each optionally squeezed by an
+//! anamorphic factor.
 
 use crate::error::{CameraError, finite};
 use glam::Vec2;
@@ -23,6 +24,8 @@ pub struct ApertureImage {
     width: usize,
     height: usize,
     distribution: Distribution2D,
+    /// The distribution's density at the brightest texel: [`ApertureImage::transmission`]'s 1.
+    peak: f32,
 }
 
 impl ApertureImage {
@@ -43,10 +46,20 @@ impl ApertureImage {
         if !weights.iter().any(|&w| w > 0.0) {
             return bad("the image is black: no light passes the aperture".to_string());
         }
+        let distribution = Distribution2D::new(weights, width, height);
+        let brightest = (0..weights.len())
+            .max_by(|&a, &b| weights[a].total_cmp(&weights[b]))
+            .unwrap_or(0);
+        let centre = Vec2::new(
+            ((brightest % width) as f32 + 0.5) / width as f32,
+            ((brightest / width) as f32 + 0.5) / height as f32,
+        );
+        let peak = distribution.pdf(centre);
         Ok(ApertureImage {
             width,
             height,
-            distribution: Distribution2D::new(weights, width, height),
+            distribution,
+            peak,
         })
     }
 
@@ -75,6 +88,13 @@ impl ApertureImage {
         0.25 * self
             .distribution
             .pdf(uv.min(Vec2::splat(obscura_sample::ONE_MINUS_EPSILON)))
+    }
+}
+
+impl ApertureImage {
+    /// The weight at `p` of `[-1, 1]^2` relative to the brightest, from 0 to 1 (0 outside).
+    fn transmission(&self, p: Vec2) -> f32 {
+        (4.0 * self.pdf(p) / self.peak).min(1.0)
     }
 }
 
@@ -225,6 +245,26 @@ impl Aperture {
             ApertureShape::Image(image) => image.pdf(q),
         };
         unsqueezed * s
+    }
+}
+
+impl Aperture {
+    /// How much light the unit aperture passes at `p` (the plane of [`Aperture::sample`], in
+    /// units of the radius, after the squeeze), from 0 to 1: 1 inside a round or polygonal
+    /// outline and 0 outside it; an image's weight there relative to its brightest. A lens
+    /// model whose rays cannot start on the aperture (a lens system's stop, reached through
+    /// the rear elements) weights them by this instead of sampling it.
+    pub fn transmission(&self, p: Vec2) -> f32 {
+        let q = Vec2::new(p.x * self.anamorphic, p.y);
+        let inside = match &self.shape {
+            ApertureShape::Circle => q.length_squared() <= 1.0,
+            ApertureShape::Polygon {
+                blades,
+                rotation_degrees,
+            } => inside_polygon(q, *blades, *rotation_degrees),
+            ApertureShape::Image(image) => return image.transmission(q),
+        };
+        if inside { 1.0 } else { 0.0 }
     }
 }
 

@@ -2,7 +2,7 @@
 //! and an aperture stop (Kolb, Mitchell and Hanrahan, "A Realistic Camera Model for Computer
 //! Graphics", SIGGRAPH 1995).
 
-use crate::MAX_BLADES;
+use crate::aperture::Aperture;
 use crate::camera::{Camera, CameraBase, CameraRay, CameraRayDifferential, CameraSample};
 use crate::chain::{self, CameraRayParts, PoseCache};
 use crate::error::{CameraError, finite};
@@ -192,7 +192,7 @@ impl LensPrescription {
 }
 
 /// The parameters of a [`RealisticCamera`] besides its base and prescription.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct RealisticLens {
     /// Diameter of the stop (mm) after stopping down; None for the stop's full diameter.
     pub aperture_diameter: Option<f32>,
@@ -200,11 +200,12 @@ pub struct RealisticLens {
     pub focus_distance: f32,
     /// The film's diagonal (mm).
     pub film_diagonal: f32,
-    /// Blades of the stop: 0 for round, else 3 to [`MAX_BLADES`] (a regular polygon inscribed
-    /// in the stop's circle).
-    pub blades: u32,
-    /// Rotation of the polygonal stop in degrees, counter-clockwise from camera +x.
-    pub rotation_degrees: f32,
+    /// The stop's opening, in units of its (stopped-down) radius: round, a regular polygon of
+    /// blades inscribed in its circle, or an image of weights, each maybe squeezed by an
+    /// anamorphic factor ([`Aperture`]). An image is the stop's transmission, its weights
+    /// relative to the brightest, cut to the stop's circle: rays through a dimmer part carry
+    /// less light.
+    pub aperture: Aperture,
 }
 
 impl Default for RealisticLens {
@@ -213,8 +214,7 @@ impl Default for RealisticLens {
             aperture_diameter: None,
             focus_distance: 10.0,
             film_diagonal: DEFAULT_FILM_DIAGONAL,
-            blades: 0,
-            rotation_degrees: 0.0,
+            aperture: Aperture::CIRCLE,
         }
     }
 }
@@ -232,6 +232,20 @@ struct Element {
     /// Index behind (film side) and in front (scene side).
     eta_film: f64,
     eta_scene: f64,
+}
+
+/// What ends a traced ray besides missing an element or total internal reflection.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Clip {
+    /// Nothing: the elements as unbounded spheres and planes.
+    No,
+    /// The elements' clear apertures and the stop's (stopped-down) circle: the same for a
+    /// film point at any azimuth, so the exit-pupil bounds, found for film points on +x and
+    /// turned to the others, are found with this.
+    Circles,
+    /// The circles and the stop's aperture inside its circle (blades, an image, a squeeze),
+    /// whose transmission the ray then carries.
+    Stop,
 }
 
 /// A ray in lens space (mm) with a unit direction.
@@ -333,7 +347,7 @@ impl RealisticCamera {
     ///
     /// Errors: non-finite numbers; an aperture diameter not in (0, the stop's diameter]
     /// ([`CameraError::ApertureDiameter`]); a film diagonal <= 0
-    /// ([`CameraError::FilmDiagonal`]); bad blades ([`CameraError::Blades`]); a lens that
+    /// ([`CameraError::FilmDiagonal`]); a bad aperture ([`Aperture::validate`]); a lens that
     /// cannot focus at that distance ([`CameraError::FocusDistance`]); the base's errors.
     pub fn new(
         base: CameraBase,
@@ -343,7 +357,6 @@ impl RealisticCamera {
         base.validate(false)?;
         finite("focus_distance", lens.focus_distance)?;
         finite("film_diagonal", lens.film_diagonal)?;
-        finite("aperture rotation", lens.rotation_degrees)?;
         let stop_diameter = prescription.stop_diameter();
         let aperture = match lens.aperture_diameter {
             Some(a) => {
@@ -363,9 +376,7 @@ impl RealisticCamera {
                 got: lens.film_diagonal,
             });
         }
-        if lens.blades == 1 || lens.blades == 2 || lens.blades > MAX_BLADES {
-            return Err(CameraError::Blades { got: lens.blades });
-        }
+        lens.aperture.validate()?;
         let focus_mm = f64::from(lens.focus_distance) * MM_PER_UNIT;
         if lens.focus_distance <= 0.0 {
             return Err(CameraError::FocusDistance {
@@ -482,8 +493,8 @@ impl RealisticCamera {
     }
 
     /// The lens parameters, with the aperture diameter resolved (mm).
-    pub fn lens(&self) -> RealisticLens {
-        self.lens
+    pub fn lens(&self) -> &RealisticLens {
+        &self.lens
     }
 
     /// The paraxial effective focal length (mm).
@@ -575,31 +586,21 @@ impl RealisticCamera {
         m
     }
 
-    /// True when a point of the stop's plane lies inside the (stopped-down, maybe polygonal)
-    /// stop.
-    fn inside_stop(&self, p: DVec2) -> bool {
+    /// The fraction of light the stop passes at a point of its plane: 0 outside its circle
+    /// (stopped down), else the aperture's transmission there ([`Aperture::transmission`], in
+    /// units of the stop's radius).
+    fn stop_transmission(&self, p: DVec2) -> f64 {
         let r = self.elements[self.stop].aperture_radius;
         if p.length_squared() > r * r {
-            return false;
+            return 0.0;
         }
-        if self.lens.blades < 3 {
-            return true;
-        }
-        // The polygon of obscura_sample::square_to_polygon: vertex k at rotation + 2 pi k / N
-        // on the circle, so edge k's outward normal is at rotation + (2k + 1) pi / N and the
-        // edges lie at the inradius r cos(pi / N).
-        let n = f64::from(self.lens.blades);
-        let rotation = f64::from(self.lens.rotation_degrees % 360.0).to_radians();
-        let inradius = r * (std::f64::consts::PI / n).cos();
-        (0..self.lens.blades).all(|k| {
-            let angle = rotation + (2.0 * f64::from(k) + 1.0) * std::f64::consts::PI / n;
-            p.dot(DVec2::new(angle.cos(), angle.sin())) <= inradius
-        })
+        f64::from(self.lens.aperture.transmission((p / r).as_vec2()))
     }
 
     /// Moves `ray` to element `i` and through it (refraction; clear-aperture and stop tests
-    /// when `clip`). None: missed, clipped, or totally internally reflected.
-    fn interact(&self, i: usize, ray: &mut LensRay, clip: bool) -> Option<()> {
+    /// as `clip` says), giving the fraction of its light that passes (below 1 only at a stop
+    /// whose aperture is an image). None: missed, clipped, or totally internally reflected.
+    fn interact(&self, i: usize, ray: &mut LensRay, clip: Clip) -> Option<f64> {
         let e = &self.elements[i];
         if e.radius == 0.0 {
             // The stop: a plane.
@@ -608,11 +609,23 @@ impl RealisticCamera {
             }
             let t = (e.z - ray.o.z) / ray.d.z;
             let p = ray.o + t * ray.d;
-            if t < 0.0 || (clip && !self.inside_stop(p.truncate())) {
+            let passed = match clip {
+                Clip::No => 1.0,
+                Clip::Circles => {
+                    let r = e.aperture_radius;
+                    if p.truncate().length_squared() <= r * r {
+                        1.0
+                    } else {
+                        0.0
+                    }
+                }
+                Clip::Stop => self.stop_transmission(p.truncate()),
+            };
+            if t < 0.0 || passed <= 0.0 {
                 return None;
             }
             ray.o = p;
-            return Some(());
+            return Some(passed);
         }
         // A sphere centred on the axis at z - radius: the root on the vertex's side.
         let centre = DVec3::new(0.0, 0.0, e.z - e.radius);
@@ -630,7 +643,7 @@ impl RealisticCamera {
             return None;
         }
         let p = ray.o + t * ray.d;
-        if clip && p.x * p.x + p.y * p.y > e.aperture_radius * e.aperture_radius {
+        if clip != Clip::No && p.x * p.x + p.y * p.y > e.aperture_radius * e.aperture_radius {
             return None;
         }
         // Snell's law with the normal facing the incoming ray.
@@ -651,23 +664,27 @@ impl RealisticCamera {
         let d = eta * ray.d + (eta * cos_i - (1.0 - sin2_t).sqrt()) * normal;
         ray.o = p;
         ray.d = d.normalize();
-        Some(())
+        Some(1.0)
     }
 
-    /// Traces a ray leaving the film through every element to the scene.
-    fn trace_from_film(&self, mut ray: LensRay, clip: bool) -> Option<LensRay> {
+    /// Traces a ray leaving the film through every element to the scene, with the fraction
+    /// of its light that passes.
+    fn trace_from_film(&self, mut ray: LensRay, clip: Clip) -> Option<(LensRay, f64)> {
+        let mut passed = 1.0;
         for i in (0..self.elements.len()).rev() {
-            self.interact(i, &mut ray, clip)?;
+            passed *= self.interact(i, &mut ray, clip)?;
         }
-        Some(ray)
+        Some((ray, passed))
     }
 
-    /// Traces a ray from the scene through every element to the film side.
-    fn trace_from_scene(&self, mut ray: LensRay, clip: bool) -> Option<LensRay> {
+    /// Traces a ray from the scene through every element to the film side, with the fraction
+    /// of its light that passes.
+    fn trace_from_scene(&self, mut ray: LensRay, clip: Clip) -> Option<(LensRay, f64)> {
+        let mut passed = 1.0;
         for i in 0..self.elements.len() {
-            self.interact(i, &mut ray, clip)?;
+            passed *= self.interact(i, &mut ray, clip)?;
         }
-        Some(ray)
+        Some((ray, passed))
     }
 
     /// The ray from film point `film` (mm, z = 0) towards rear-plane point `rear`.
@@ -700,7 +717,7 @@ impl RealisticCamera {
                         o: object,
                         d: (target - object).normalize(),
                     };
-                    let Some(out) = self.trace_from_scene(ray, true) else {
+                    let Some((out, _)) = self.trace_from_scene(ray, Clip::Stop) else {
                         continue;
                     };
                     if out.d.z >= 0.0 {
@@ -748,7 +765,10 @@ impl RealisticCamera {
                 for i in 0..BOUND_GRID {
                     for j in 0..BOUND_GRID {
                         let q = min + cell * DVec2::new(i as f64 + 0.5, j as f64 + 0.5);
-                        if self.trace_from_film(self.film_ray(film, q), true).is_some() {
+                        if self
+                            .trace_from_film(self.film_ray(film, q), Clip::Circles)
+                            .is_some()
+                        {
                             bound.include(q);
                         }
                     }
@@ -788,8 +808,8 @@ impl RealisticCamera {
     }
 
     /// The film centre's irradiance from a uniform unit sky, up to the constant `delta^2`:
-    /// the integral over the rear plane of `cos^4(theta)` where a ray gets through, by the
-    /// midpoint rule over the centre's bound.
+    /// the integral over the rear plane of `cos^4(theta)` times the light that gets through,
+    /// by the midpoint rule over the centre's bound.
     fn centre_irradiance(&self) -> f64 {
         let b = self.bounds[0];
         if b.is_empty() {
@@ -801,8 +821,8 @@ impl RealisticCamera {
             for j in 0..NORMALISER_GRID {
                 let q = b.min + size * DVec2::new(i as f64 + 0.5, j as f64 + 0.5);
                 let ray = self.film_ray(DVec2::ZERO, q);
-                if self.trace_from_film(ray, true).is_some() {
-                    sum += ray.d.z.powi(4);
+                if let Some((_, passed)) = self.trace_from_film(ray, Clip::Stop) {
+                    sum += ray.d.z.powi(4) * passed;
                 }
             }
         }
@@ -836,10 +856,10 @@ impl RealisticCamera {
         let q = bound.min + (bound.max - bound.min) * u.as_dvec2();
         let azimuth = if r > 0.0 { film / r } else { DVec2::X };
         let rear = azimuth.rotate(q);
-        // Trace; weight cos^4(theta) A / (delta^2 E_0).
+        // Trace; weight cos^4(theta) A T / (delta^2 E_0), T the light the stop passes.
         let ray = self.film_ray(film, rear);
-        let out = self.trace_from_film(ray, true)?;
-        let weight = ray.d.z.powi(4) * bound.area() * self.weight_scale;
+        let (out, passed) = self.trace_from_film(ray, Clip::Stop)?;
+        let weight = ray.d.z.powi(4) * bound.area() * passed * self.weight_scale;
         Some((out, weight))
     }
 
@@ -861,7 +881,7 @@ impl RealisticCamera {
         axis: DVec2,
     ) -> Option<(f64, LensRay)> {
         for i in range {
-            self.interact(i, &mut ray, false)?;
+            self.interact(i, &mut ray, Clip::No)?;
         }
         Some((ray.o.truncate().dot(axis), ray))
     }
@@ -934,7 +954,7 @@ impl RealisticCamera {
         let h = Self::solve(h0, self.elements[n - 1].aperture_radius, height)?;
         let (_, mut at_stop) = self.stop_height(ray_to(h), (self.stop..n).rev(), axis)?;
         for i in (0..self.stop).rev() {
-            self.interact(i, &mut at_stop, false)?;
+            self.interact(i, &mut at_stop, Clip::No)?;
         }
         Some(at_stop)
     }
@@ -949,11 +969,11 @@ impl RealisticCamera {
         let through = |mut ray: LensRay| -> Option<LensRay> {
             if towards_scene {
                 for i in (0..self.stop).rev() {
-                    self.interact(i, &mut ray, false)?;
+                    self.interact(i, &mut ray, Clip::No)?;
                 }
             } else {
                 for i in self.stop + 1..n {
-                    self.interact(i, &mut ray, false)?;
+                    self.interact(i, &mut ray, Clip::No)?;
                 }
             }
             Some(ray)
@@ -1012,7 +1032,7 @@ impl RealisticCamera {
         let h = Self::solve(h0, self.elements[0].aperture_radius, height)?;
         let (_, mut ray) = self.stop_height(ray_to(h), 0..=self.stop, axis)?;
         for i in self.stop + 1..self.elements.len() {
-            self.interact(i, &mut ray, false)?;
+            self.interact(i, &mut ray, Clip::No)?;
         }
         if ray.d.z >= 0.0 {
             return None;

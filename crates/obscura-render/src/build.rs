@@ -11,10 +11,10 @@ use crate::scene::{DEFAULT_INTERAXIAL, camera_key};
 use glam::Vec3;
 use obscura_accel::{Placement, Scene, SceneBuilder, Shape, TriangleMesh};
 use obscura_camera::{
-    AnyCamera, ApertureShape, CameraBase, CameraError, CubeFaceCamera, CylindricalCamera,
-    EnvironmentCamera, FilmGeometry, FisheyeCamera, LookAt, OctahedralCamera, OdsCamera,
-    OpenCvCamera, OpenCvFisheyeCamera, OrthographicCamera, PerspectiveCamera, RealisticCamera,
-    RealisticLens, ScreenWindow, look_at_pose, opencv_pose,
+    AnyCamera, CameraBase, CameraError, CubeFaceCamera, CylindricalCamera, EnvironmentCamera,
+    FilmGeometry, FisheyeCamera, LookAt, OctahedralCamera, OdsCamera, OpenCvCamera,
+    OpenCvFisheyeCamera, OrthographicCamera, PerspectiveCamera, RealisticCamera, RealisticLens,
+    ScreenWindow, look_at_pose, opencv_pose,
 };
 use obscura_sample::Sampler;
 use obscura_shade::{EnvironmentLight, Light, Material, ShadingScene};
@@ -357,21 +357,13 @@ pub(crate) fn build_camera(
                     line: None,
                     message: "no lens_file".into(),
                 })?;
-            // The stop is round or a polygon: the scene layer refuses aperture images and
-            // squeezes on a lens system.
-            let (blades, rotation_degrees) = match c.lens.aperture.shape {
-                ApertureShape::Polygon {
-                    blades,
-                    rotation_degrees,
-                } => (blades, rotation_degrees),
-                _ => (0, 0.0),
-            };
+            // The stop takes the aperture the scene layer built for the thin lens (blades, an
+            // image, a squeeze), in units of the stop's radius.
             let lens = RealisticLens {
                 aperture_diameter: r.aperture_diameter,
                 focus_distance: r.focus_distance,
                 film_diagonal: r.film_diagonal,
-                blades,
-                rotation_degrees,
+                aperture: c.lens.aperture.clone(),
             };
             RealisticCamera::new(base, &r.prescription, lens)?.into()
         }

@@ -1,4 +1,5 @@
 use super::*;
+use crate::aperture::{ApertureImage, ApertureShape};
 use crate::{FilmGeometry, LookAt, Shutter, look_at_pose};
 use obscura_space::Vector3;
 use proptest::prelude::*;
@@ -113,39 +114,48 @@ fn bad_parameters_are_errors() {
     assert!(matches!(
         with(RealisticLens {
             aperture_diameter: Some(17.2),
-            ..d
+            ..d.clone()
         }),
         Err(CameraError::ApertureDiameter { .. })
     ));
     assert!(matches!(
         with(RealisticLens {
             aperture_diameter: Some(0.0),
-            ..d
+            ..d.clone()
         }),
         Err(CameraError::ApertureDiameter { .. })
     ));
     assert!(matches!(
         with(RealisticLens {
             focus_distance: 0.01,
-            ..d
+            ..d.clone()
         }),
         Err(CameraError::FocusDistance { .. })
     ));
     assert!(matches!(
         with(RealisticLens {
             film_diagonal: 0.0,
-            ..d
+            ..d.clone()
         }),
         Err(CameraError::FilmDiagonal { .. })
     ));
     assert!(matches!(
-        with(RealisticLens { blades: 2, ..d }),
+        with(RealisticLens {
+            aperture: Aperture {
+                shape: ApertureShape::Polygon {
+                    blades: 2,
+                    rotation_degrees: 0.0
+                },
+                anamorphic: 1.0
+            },
+            ..d.clone()
+        }),
         Err(CameraError::Blades { .. })
     ));
     assert!(matches!(
         with(RealisticLens {
             focus_distance: f32::NAN,
-            ..d
+            ..d.clone()
         }),
         Err(CameraError::NonFinite { .. })
     ));
@@ -295,10 +305,25 @@ fn a_point_at_the_focus_distance_images_to_a_small_spot() {
 
 #[test]
 fn every_ray_that_gets_through_starts_inside_the_pupil_bound() {
+    // Also a stop that is not round (six blades, squeezed by 2): the bounds are found for film
+    // points on +x and turned to each film point's azimuth, so they must hold the rays of the
+    // stop's circle, which any turn of the stop stays inside.
+    let squeezed = camera(
+        DOUBLE_GAUSS,
+        [48, 32],
+        RealisticLens {
+            focus_distance: 2.0,
+            aperture: Aperture::polygon(6, 15.0)
+                .and_then(|a| a.with_anamorphic(2.0))
+                .unwrap(),
+            ..RealisticLens::default()
+        },
+    );
     for camera in [
         double_gauss(),
         &focused(WIDE, 3.0),
         &focused(TELEPHOTO, 20.0),
+        &squeezed,
     ] {
         let rear = 1.5 * camera.elements.last().unwrap().aperture_radius;
         let mut u = Uniforms(7);
@@ -312,7 +337,7 @@ fn every_ray_that_gets_through_starts_inside_the_pupil_bound() {
                 // Anywhere on the rear element's plane, well beyond its clear aperture.
                 let q = DVec2::new(2.0 * u.next() - 1.0, 2.0 * u.next() - 1.0) * rear;
                 if camera
-                    .trace_from_film(camera.film_ray(film, q), true)
+                    .trace_from_film(camera.film_ray(film, q), Clip::Stop)
                     .is_some()
                 {
                     through += 1;
@@ -338,7 +363,7 @@ fn irradiance_brute(camera: &RealisticCamera, film: DVec2, n: usize, seed: u64) 
     for _ in 0..n {
         let q = DVec2::new(2.0 * u.next() - 1.0, 2.0 * u.next() - 1.0) * rear;
         let ray = camera.film_ray(film, q);
-        let f = if camera.trace_from_film(ray, true).is_some() {
+        let f = if camera.trace_from_film(ray, Clip::Stop).is_some() {
             area * ray.d.z.powi(4)
         } else {
             0.0
@@ -421,28 +446,136 @@ fn the_stop_is_the_samplers_polygon() {
         RealisticLens {
             focus_distance: 2.0,
             aperture_diameter: Some(8.0),
-            blades: 6,
-            rotation_degrees: 15.0,
+            aperture: Aperture::polygon(6, 15.0).unwrap(),
             ..RealisticLens::default()
         },
     );
     let r = 4.0;
+    let inside = |p: DVec2| camera.stop_transmission(p) > 0.0;
     for i in 0..32 {
         for j in 0..32 {
             let u = glam::Vec2::new((i as f32 + 0.5) / 32.0, (j as f32 + 0.5) / 32.0);
             let p = obscura_sample::square_to_polygon(u, 6, 15.0).as_dvec2() * r;
-            assert!(camera.inside_stop(p * 0.999), "{p}");
+            assert!(inside(p * 0.999), "{p}");
         }
     }
     // The vertices are on the circle at 15 + 60 k degrees; the edge midpoints at the inradius.
     for k in 0..6 {
         let vertex = (15.0 + 60.0 * k as f64).to_radians();
         let v = DVec2::new(vertex.cos(), vertex.sin()) * r;
-        assert!(camera.inside_stop(v * 0.999) && !camera.inside_stop(v * 1.001));
+        assert!(inside(v * 0.999) && !inside(v * 1.001));
         let mid = (45.0 + 60.0 * k as f64).to_radians();
         let m = DVec2::new(mid.cos(), mid.sin()) * r * (std::f64::consts::PI / 6.0).cos();
-        assert!(camera.inside_stop(m * 0.999) && !camera.inside_stop(m * 1.001));
+        assert!(inside(m * 0.999) && !inside(m * 1.001));
     }
+}
+
+/// The film centre's rays through the stop on a grid of lens samples: where each crosses
+/// the stop's plane, and its weight.
+fn centre_rays_at_the_stop(camera: &RealisticCamera, n: usize) -> Vec<(DVec2, f64)> {
+    let mut out = Vec::new();
+    let bound = camera.bounds[0];
+    for i in 0..n {
+        for j in 0..n {
+            let u = glam::Vec2::new((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
+            let Some((_, weight)) = camera.lens_ray(DVec2::ZERO, u) else {
+                continue;
+            };
+            // The same ray as lens_ray's, followed from the rear element to the stop.
+            let q = bound.min + (bound.max - bound.min) * u.as_dvec2();
+            let mut ray = camera.film_ray(DVec2::ZERO, q);
+            for k in (camera.stop..camera.elements.len()).rev() {
+                camera.interact(k, &mut ray, Clip::No).unwrap();
+            }
+            out.push((ray.o.truncate(), weight));
+        }
+    }
+    out
+}
+
+#[test]
+fn an_image_stop_passes_light_in_proportion_to_its_weights() {
+    // A 2 x 1 image: the left half of the stop (camera -x) passes everything, the right half
+    // half of it. The stop is cut to its circle (the image's square reaches beyond it).
+    let image = ApertureImage::new(&[1.0, 0.5], 2, 1).unwrap();
+    let camera = camera(
+        DOUBLE_GAUSS,
+        [48, 32],
+        RealisticLens {
+            focus_distance: 2.0,
+            aperture_diameter: Some(8.0),
+            aperture: Aperture::image(image),
+            ..RealisticLens::default()
+        },
+    );
+    let r = 4.0;
+    assert_eq!(camera.stop_transmission(DVec2::new(-0.5 * r, 0.2)), 1.0);
+    assert_eq!(camera.stop_transmission(DVec2::new(0.5 * r, -0.2)), 0.5);
+    assert_eq!(camera.stop_transmission(DVec2::new(-0.8 * r, 0.8 * r)), 0.0);
+    // The same rays as through the round stop of the same size (its circle bounds the
+    // pupil alike), each weighted by its half's transmission over the mean transmission
+    // (both normalise the film centre to 1): 1 / 0.75 on the left, 0.5 / 0.75 on the right.
+    let rays = centre_rays_at_the_stop(&camera, 96);
+    let plain = centre_rays_at_the_stop(&camera_with(&camera, Aperture::CIRCLE), 96);
+    assert_eq!(plain.len(), rays.len());
+    assert!(rays.len() > 1000, "{}", rays.len());
+    let c = rays[0].1 / plain[0].1 * if rays[0].0.x < 0.0 { 1.0 } else { 2.0 };
+    assert!((c - 1.0 / 0.75).abs() < 0.02, "{c}");
+    for ((p, w), (q, w_round)) in rays.iter().zip(&plain) {
+        assert_eq!(p, q);
+        let expected = if p.x < 0.0 { c } else { 0.5 * c };
+        assert!(
+            (w / w_round - expected).abs() < 1e-9 * expected,
+            "{p} {w} {w_round}"
+        );
+    }
+}
+
+/// `camera` with another stop aperture.
+fn camera_with(camera: &RealisticCamera, aperture: Aperture) -> RealisticCamera {
+    RealisticCamera::new(
+        camera.base().clone(),
+        camera.prescription(),
+        RealisticLens {
+            aperture,
+            ..camera.lens().clone()
+        },
+    )
+    .unwrap()
+}
+
+#[test]
+fn an_anamorphic_stop_is_an_oval() {
+    // Squeezed by 2: the round stop of radius 4 becomes the ellipse of semi-axes 2 (x) and
+    // 4 (y). The exit-pupil bounds stay the round stop's: they are turned to each film
+    // point's azimuth, which only a round outline survives.
+    let camera = camera(
+        DOUBLE_GAUSS,
+        [48, 32],
+        RealisticLens {
+            focus_distance: 2.0,
+            aperture_diameter: Some(8.0),
+            aperture: Aperture::CIRCLE.with_anamorphic(2.0).unwrap(),
+            ..RealisticLens::default()
+        },
+    );
+    assert_eq!(camera.stop_transmission(DVec2::new(1.9, 0.0)), 1.0);
+    assert_eq!(camera.stop_transmission(DVec2::new(2.1, 0.0)), 0.0);
+    assert_eq!(camera.stop_transmission(DVec2::new(0.0, 3.9)), 1.0);
+    let size = camera.bounds[0].max - camera.bounds[0].min;
+    assert!((size.x / size.y - 1.0).abs() < 0.05, "{size}");
+    // Every ray from the film centre crosses the stop inside the ellipse.
+    let rays = centre_rays_at_the_stop(&camera, 64);
+    assert!(rays.len() > 1000, "{}", rays.len());
+    for (p, _) in &rays {
+        assert!(
+            (p.x / 2.0).powi(2) + (p.y / 4.0).powi(2) <= 1.0 + 1e-9,
+            "{p}"
+        );
+    }
+    // The round stop's rays reach x = 3.9, past the ellipse.
+    let round = centre_rays_at_the_stop(&camera_with(&camera, Aperture::CIRCLE), 64);
+    assert!(round.iter().any(|(p, _)| p.x > 3.5));
 }
 
 #[test]

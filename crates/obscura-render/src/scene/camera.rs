@@ -108,9 +108,10 @@ fn reads(kind: CameraKind, key: &str) -> bool {
     match key {
         "fov" => matches!(kind, Perspective | Fisheye | Cylindrical),
         "fov_axis" => kind == Perspective,
-        "screen_window" | "lens_radius" | "focal_distance" | "aperture_image" | "anamorphic"
-        | "focal_length" => matches!(kind, Perspective | Orthographic),
-        "aperture_blades" | "aperture_rotation" => {
+        "screen_window" | "lens_radius" | "focal_distance" | "focal_length" => {
+            matches!(kind, Perspective | Orthographic)
+        }
+        "aperture_blades" | "aperture_rotation" | "aperture_image" | "anamorphic" => {
             matches!(kind, Perspective | Orthographic | Realistic)
         }
         "lens_file" | "aperture_diameter" | "focus_distance" | "film_diagonal" => kind == Realistic,
