@@ -77,15 +77,18 @@ impl StereoRig {
     }
 
     /// The eye's screen window: the rig's window shifted by `-s e / C` in screen x, with the
-    /// perspective scale `s = h / tan(fov / 2)` of a camera of `fov_degrees` along `fov_axis`.
+    /// perspective scale `s = h / tan(fov / 2)` of a camera of `fov_degrees` along `fov_axis`
+    /// on a film of `resolution` (`h` the default window's half-extent along the axis, as
+    /// [`PerspectiveCamera`](crate::PerspectiveCamera) takes it).
     pub fn eye_window(
         &self,
         eye: StereoEye,
         window: ScreenWindow,
         fov_degrees: f32,
         fov_axis: FovAxis,
+        resolution: [u32; 2],
     ) -> Result<ScreenWindow, CameraError> {
-        let half_extent = f64::from(fov_axis.half_extent(window));
+        let half_extent = f64::from(fov_axis.half_extent(ScreenWindow::default_for(resolution)));
         let scale = half_extent / (0.5 * f64::from(fov_degrees)).to_radians().tan();
         let shift = (-scale * f64::from(self.offset(eye)) / f64::from(self.convergence)) as f32;
         ScreenWindow::new(

@@ -313,7 +313,7 @@ pub(crate) fn build_camera(
             .unwrap_or_else(|| ScreenWindow::default_for(resolution))
             .lens_shifted(c.lens_shift)?;
         if let Some((eye, rig)) = eye {
-            w = rig.eye_window(eye, w, c.fov, c.fov_axis)?;
+            w = rig.eye_window(eye, w, c.fov, c.fov_axis, resolution)?;
         }
         window = Some(w);
     }

@@ -4,7 +4,7 @@
 use crate::{assert_close2, assert_close3, base_at, identity_look, projective_strategy, raster_in};
 use obscura_camera::{
     AnyCamera, Camera, CameraSample, FovAxis, OrthographicCamera, PerspectiveCamera,
-    ProjectiveCamera, ThinLens,
+    ProjectiveCamera, ScreenWindow, ThinLens,
 };
 use obscura_space::{Point2, Point3, Raster, Vector3};
 use proptest::prelude::*;
@@ -390,6 +390,42 @@ fn each_non_finite_field_alone_gives_no_ray() {
             assert!(
                 camera.generate_ray_differential(&sample).is_none(),
                 "{bad} in field {field}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_screen_window_is_a_window_onto_the_fovs_screen() {
+    // pbrt's screen space: the fov fixes the scale, s = 1 / tan(fov / 2) along the smaller
+    // axis of the default window, and a screen window given in the scene picks a part of that
+    // screen. By hand, fov 90 on a square film (s = 1, screen x = camera x / z): the window
+    // [0, 1] x [0, 1] sees x / z and y / z from 0 to 1, so the top-left raster corner looks
+    // along (0, 1, 1), the bottom-right along (1, 0, 1), the centre along (0.5, 0.5, 1). The
+    // same window twice as large, [-0.5, 1.5]^2, sees twice the range about the same centre.
+    let window = |w: [f32; 4]| ScreenWindow::new(w[0], w[1], w[2], w[3]).unwrap();
+    for (w, corner, centre) in [
+        ([0.0, 1.0, 0.0, 1.0], [0.0, 1.0], [0.5, 0.5]),
+        ([-0.5, 1.5, -0.5, 1.5], [-0.5, 1.5], [0.5, 0.5]),
+    ] {
+        let base = base_at(identity_look(), [100, 100], Some(window(w)), 0.001, 1e30);
+        let camera =
+            PerspectiveCamera::new(base, 90.0, FovAxis::Smaller, ThinLens::PINHOLE).unwrap();
+        for (raster, slope) in [([0.0, 0.0], corner), ([50.0, 50.0], centre)] {
+            let ray = camera
+                .generate_ray(&CameraSample {
+                    p_film: Point2::<Raster>::new(raster[0], raster[1]),
+                    p_lens: glam::Vec2::splat(0.5),
+                    time: 0.0,
+                })
+                .unwrap()
+                .ray;
+            // identity_look: camera +x = world +x, +y = world +y, +z = world -z.
+            let d = ray.direction.to_glam();
+            let got = [d.x / -d.z, d.y / -d.z];
+            assert!(
+                (got[0] - slope[0]).abs() < 1e-5 && (got[1] - slope[1]).abs() < 1e-5,
+                "window {w:?}, raster {raster:?}: {got:?} against {slope:?}"
             );
         }
     }

@@ -19,7 +19,9 @@ fn eye_camera(
 ) -> PerspectiveCamera {
     let window = ScreenWindow::default_for(resolution);
     let eye_look = rig.eye_look_at(eye, look).unwrap();
-    let eye_window = rig.eye_window(eye, window, fov, FovAxis::Smaller).unwrap();
+    let eye_window = rig
+        .eye_window(eye, window, fov, FovAxis::Smaller, resolution)
+        .unwrap();
     let base = base_at(eye_look, resolution, Some(eye_window), 0.001, 1e30);
     PerspectiveCamera::new(base, fov, FovAxis::Smaller, ThinLens::PINHOLE).unwrap()
 }
