@@ -67,18 +67,23 @@ fn each_lens_renders_the_spheres_where_project_puts_them() {
     }
 }
 
+/// The scene's camera alone under a uniform sky of radiance 1: 9 x 9 pixels, 4096 samples.
+fn under_a_uniform_sky(d: SceneDescription) -> Image {
+    let mut d = aov(d, IntegratorKind::Path, [9, 9], 4096);
+    d.film.filter = FilterSettings::Box { radius: 0.5 };
+    d.shapes.clear();
+    d.lights = vec![LightSettings::Environment {
+        radiance: [1.0, 1.0, 1.0],
+        file: None,
+        transform: Transform::<World, World>::IDENTITY,
+    }];
+    render_image(d, 2)
+}
+
 #[test]
 fn a_uniform_sky_renders_as_one_at_the_centre_and_darker_in_the_corners() {
     for lens in LENSES {
-        let mut d = aov(with_lens(lens), IntegratorKind::Path, [9, 9], 4096);
-        d.film.filter = FilterSettings::Box { radius: 0.5 };
-        d.shapes.clear();
-        d.lights = vec![LightSettings::Environment {
-            radiance: [1.0, 1.0, 1.0],
-            file: None,
-            transform: Transform::<World, World>::IDENTITY,
-        }];
-        let image = render_image(d, 2);
+        let image = under_a_uniform_sky(with_lens(lens));
         // About 4096 samples of values in [0, ~2]: a standard error near 0.01.
         let centre = pixel(&image, 4, 4)[0];
         assert!((centre - 1.0).abs() < 0.05, "{lens}: centre {centre}");
@@ -100,7 +105,7 @@ fn the_stop_takes_the_aperture_keys_of_the_scene_file() {
         "film_diagonal = 35.0",
         "film_diagonal = 35.0\nanamorphic = 2.0\naperture_blades = 6",
     );
-    let mut d = obscura_render::parse_description(&path, &text).unwrap();
+    let d = obscura_render::parse_description(&path, &text).unwrap();
     assert!(d.ignored.is_empty(), "{:?}", d.ignored);
     let scene = RenderScene::build(d.clone()).unwrap();
     let AnyCamera::Realistic(camera) = &scene.camera else {
@@ -109,14 +114,6 @@ fn the_stop_takes_the_aperture_keys_of_the_scene_file() {
     assert_eq!(camera.lens().aperture.anamorphic, 2.0);
     assert_eq!(camera.lens().aperture.blades(), 6);
 
-    d = aov(d, IntegratorKind::Path, [9, 9], 4096);
-    d.film.filter = FilterSettings::Box { radius: 0.5 };
-    d.shapes.clear();
-    d.lights = vec![LightSettings::Environment {
-        radiance: [1.0, 1.0, 1.0],
-        file: None,
-        transform: Transform::<World, World>::IDENTITY,
-    }];
-    let centre = pixel(&render_image(d, 2), 4, 4)[0];
+    let centre = pixel(&under_a_uniform_sky(d), 4, 4)[0];
     assert!((centre - 1.0).abs() < 0.05, "centre {centre}");
 }

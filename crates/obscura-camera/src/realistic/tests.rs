@@ -438,18 +438,23 @@ fn relative_illumination_matches_brute_force_and_is_one_at_the_centre() {
     }
 }
 
-#[test]
-fn the_stop_is_the_samplers_polygon() {
-    let camera = camera(
+/// The double Gauss focused at 2 m, stopped down to 8 mm, with the stop's `aperture`.
+fn stopped_down(aperture: Aperture) -> RealisticCamera {
+    camera(
         DOUBLE_GAUSS,
         [48, 32],
         RealisticLens {
             focus_distance: 2.0,
             aperture_diameter: Some(8.0),
-            aperture: Aperture::polygon(6, 15.0).unwrap(),
+            aperture,
             ..RealisticLens::default()
         },
-    );
+    )
+}
+
+#[test]
+fn the_stop_is_the_samplers_polygon() {
+    let camera = stopped_down(Aperture::polygon(6, 15.0).unwrap());
     let r = 4.0;
     let inside = |p: DVec2| camera.stop_transmission(p) > 0.0;
     for i in 0..32 {
@@ -498,16 +503,7 @@ fn an_image_stop_passes_light_in_proportion_to_its_weights() {
     // A 2 x 1 image: the left half of the stop (camera -x) passes everything, the right half
     // half of it. The stop is cut to its circle (the image's square reaches beyond it).
     let image = ApertureImage::new(&[1.0, 0.5], 2, 1).unwrap();
-    let camera = camera(
-        DOUBLE_GAUSS,
-        [48, 32],
-        RealisticLens {
-            focus_distance: 2.0,
-            aperture_diameter: Some(8.0),
-            aperture: Aperture::image(image),
-            ..RealisticLens::default()
-        },
-    );
+    let camera = stopped_down(Aperture::image(image));
     let r = 4.0;
     assert_eq!(camera.stop_transmission(DVec2::new(-0.5 * r, 0.2)), 1.0);
     assert_eq!(camera.stop_transmission(DVec2::new(0.5 * r, -0.2)), 0.5);
@@ -549,16 +545,7 @@ fn an_anamorphic_stop_is_an_oval() {
     // Squeezed by 2: the round stop of radius 4 becomes the ellipse of semi-axes 2 (x) and
     // 4 (y). The exit-pupil bounds stay the round stop's: they are turned to each film
     // point's azimuth, which only a round outline survives.
-    let camera = camera(
-        DOUBLE_GAUSS,
-        [48, 32],
-        RealisticLens {
-            focus_distance: 2.0,
-            aperture_diameter: Some(8.0),
-            aperture: Aperture::CIRCLE.with_anamorphic(2.0).unwrap(),
-            ..RealisticLens::default()
-        },
-    );
+    let camera = stopped_down(Aperture::CIRCLE.with_anamorphic(2.0).unwrap());
     assert_eq!(camera.stop_transmission(DVec2::new(1.9, 0.0)), 1.0);
     assert_eq!(camera.stop_transmission(DVec2::new(2.1, 0.0)), 0.0);
     assert_eq!(camera.stop_transmission(DVec2::new(0.0, 3.9)), 1.0);
