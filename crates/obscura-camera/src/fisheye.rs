@@ -96,8 +96,10 @@ impl FromStr for FisheyeProjection {
 ///
 /// Conventions: image right is camera +x, image up is camera +y (raster y points down, hence
 /// the minus). The image circle's diameter is the smaller image dimension, so its radius is
-/// `R = min(W, H) / 2`; its centre is `c = (W/2 + s_x W, H/2 - s_y H)` for the lens shift
-/// `[s_x, s_y]` (fractions of the image size, +x right, +y up). `fov` is the full angle across
+/// `R = min(W, H) / 2`; its centre is `c = (W/2 - s_x W, H/2 + s_y H)` for the lens shift
+/// `[s_x, s_y]` (fractions of the image size, +x right, +y up): the picture moves as a
+/// perspective camera's does under the same shift, so `s_y > 0` shows more above, as a rising
+/// front does. `fov` is the full angle across
 /// the image circle, so the focal length in pixels follows from `f r(fov / 2) = R`.
 ///
 /// Valid region: film points with `|p - c| <= R` (the rim included) give rays; points outside
@@ -120,9 +122,9 @@ pub struct FisheyeCamera {
 }
 
 impl FisheyeCamera {
-    /// A fisheye of the given projection and full field of view `fov_degrees`, its image
-    /// circle moved by `lens_shift` (fractions of the image size, +x right, +y up; `[0, 0]`
-    /// centres it). Errors: non-finite numbers ([`CameraError::NonFinite`]), a field of view
+    /// A fisheye of the given projection and full field of view `fov_degrees`, its view
+    /// shifted by `lens_shift` (fractions of the image size, +x right, +y up, as for the
+    /// perspective camera: the image circle moves the other way; `[0, 0]` centres it). Errors: non-finite numbers ([`CameraError::NonFinite`]), a field of view
     /// outside the projection's range ([`CameraError::FisheyeFov`]: `(0, 360]` equidistant and
     /// equisolid, `(0, 360)` stereographic, `(0, 180)` orthographic), and the base's errors
     /// (`near < 0`, `near >= far`, a bad shutter).
@@ -155,8 +157,8 @@ impl FisheyeCamera {
         let radius = 0.5 * width.min(height);
         let focal = radius / projection.radius(half_fov);
         let centre = [
-            width * (0.5 + f64::from(lens_shift[0])),
-            height * (0.5 - f64::from(lens_shift[1])),
+            width * (0.5 - f64::from(lens_shift[0])),
+            height * (0.5 + f64::from(lens_shift[1])),
         ];
         Ok(FisheyeCamera {
             pose: PoseCache::new(&base),

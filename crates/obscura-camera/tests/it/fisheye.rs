@@ -3,8 +3,11 @@
 
 use crate::ray_checks::{camera_ray, check_derivative, check_neighbours};
 use crate::{assert_close3, base_at, identity_look, look_strategy};
-use obscura_camera::{Camera, CameraError, CameraSample, FisheyeCamera, FisheyeProjection};
-use obscura_space::Point2;
+use obscura_camera::{
+    Camera, CameraError, CameraSample, FisheyeCamera, FisheyeProjection, FovAxis,
+    PerspectiveCamera, ScreenWindow, ThinLens,
+};
+use obscura_space::{Point2, Point3};
 use proptest::prelude::*;
 
 const PROJECTIONS: [FisheyeProjection; 4] = [
@@ -107,33 +110,62 @@ fn full_sphere_lenses() {
     );
 }
 
-/// The image circle: its diameter is the smaller dimension, centred, moved by the lens shift
-/// (+x right, +y up); outside it no ray leaves (generate_ray and the differential give None).
+/// The image circle: its diameter is the smaller dimension, centred, moved against the lens
+/// shift (which, +x right and +y up, shifts the view as for the perspective camera); outside it
+/// no ray leaves (generate_ray and the differential give None).
 #[test]
 fn image_circle_and_lens_shift() {
-    // 1000 x 500: R = 250. Shift [0.1, 0.2]: centre (500 + 100, 250 - 100) = (600, 150).
+    // 1000 x 500: R = 250. Shift [0.125, 0.25] (exact in binary): the view moves right and
+    // up, so the axis lands left of and below the middle: centre (500 - 125, 250 + 125) =
+    // (375, 375).
     let camera = fisheye(
         [1000, 500],
         FisheyeProjection::Equidistant,
         180.0,
-        [0.1, 0.2],
+        [0.125, 0.25],
     );
     let (centre, radius) = camera.image_circle();
-    assert_eq!((centre.x, centre.y, radius), (600.0, 150.0, 250.0));
-    let (_, d) = camera_ray(&camera, Point2::new(600.0, 150.0)).unwrap();
+    assert_eq!((centre.x, centre.y, radius), (375.0, 375.0, 250.0));
+    let (_, d) = camera_ray(&camera, Point2::new(375.0, 375.0)).unwrap();
     assert_close3(d, glam::Vec3::Z, 1e-6);
-    // The rim (x = 850) looks along +x (theta = 90 degrees), just past it there is no ray.
-    let (_, d) = camera_ray(&camera, Point2::new(850.0, 150.0)).unwrap();
+    // The rim (x = 625) looks along +x (theta = 90 degrees), just past it there is no ray.
+    let (_, d) = camera_ray(&camera, Point2::new(625.0, 375.0)).unwrap();
     assert_close3(d, glam::Vec3::X, 1e-6);
     for p in [
-        Point2::new(850.01, 150.0),
-        Point2::new(600.0, 400.01),
+        Point2::new(625.01, 375.0),
+        Point2::new(375.0, 124.99),
         Point2::new(0.5, 0.5),
         Point2::new(999.5, 499.5),
     ] {
         let sample = CameraSample::at(p);
         assert!(camera.generate_ray(&sample).is_none(), "{p:?}");
         assert!(camera.generate_ray_differential(&sample).is_none());
+    }
+}
+
+#[test]
+fn a_lens_shift_moves_the_fisheye_as_it_moves_the_perspective_camera() {
+    // The same shift on a perspective camera moves its screen window right and up, so the
+    // picture moves by (-sx W, +sy H) and the optical axis lands at (500 - 125, 250 + 125):
+    // where the fisheye's image circle is centred, so both show more to the right and above.
+    let (resolution, shift) = ([1000, 500], [0.125, 0.25]);
+    let window = ScreenWindow::default_for(resolution)
+        .lens_shifted(shift)
+        .unwrap();
+    let base = base_at(identity_look(), resolution, Some(window), 0.001, 1.0e30);
+    let perspective =
+        PerspectiveCamera::new(base, 90.0, FovAxis::Smaller, ThinLens::PINHOLE).unwrap();
+    let fisheye = fisheye(resolution, FisheyeProjection::Equidistant, 180.0, shift);
+    // identity_look: the axis is world -z.
+    let axis = Point3::new(0.0, 0.0, -10.0);
+    for p in [
+        perspective.project(axis, 0.0).unwrap(),
+        fisheye.project(axis, 0.0).unwrap(),
+    ] {
+        assert!(
+            (p.x - 375.0).abs() < 1e-3 && (p.y - 375.0).abs() < 1e-3,
+            "{p:?}"
+        );
     }
 }
 
