@@ -169,7 +169,7 @@ pub enum FovAxis {
 }
 
 impl FovAxis {
-    /// The half-extent of `window` that the fov spans.
+    /// The half-extent of `window` along this axis (the fov spans the default window's).
     pub fn half_extent(self, window: ScreenWindow) -> f32 {
         let [hx, hy] = window.half_extent();
         match self {
@@ -179,6 +179,14 @@ impl FovAxis {
             FovAxis::Y => hy,
             FovAxis::Diagonal => hx.hypot(hy),
         }
+    }
+
+    /// The perspective scale `s = h / tan(fov / 2)` of a film of `resolution`, `h` the
+    /// default window's half-extent along this axis: pbrt's screen space, onto which a screen
+    /// window given in the scene is a window.
+    pub(crate) fn perspective_scale(self, resolution: [u32; 2], fov_degrees: f32) -> f64 {
+        let half_extent = f64::from(self.half_extent(ScreenWindow::default_for(resolution)));
+        half_extent / (0.5 * f64::from(fov_degrees)).to_radians().tan()
     }
 
     /// The scene-file name: `"smaller"`, `"larger"`, `"x"`, `"y"` or `"diagonal"`.

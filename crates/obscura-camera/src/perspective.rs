@@ -5,7 +5,7 @@ use crate::camera::{
     differential_at, differential_film_points, ray_time,
 };
 use crate::error::{CameraError, finite};
-use crate::film::{FovAxis, ScreenWindow};
+use crate::film::FovAxis;
 use crate::projective::{ProjectiveCamera, from_rows};
 use glam::{Vec2, Vec3, Vec3A};
 use obscura_space::{Point2, Point3, Raster, Ray, Vector3, World};
@@ -97,11 +97,7 @@ impl PerspectiveCamera {
     ) -> Result<PerspectiveCamera, CameraError> {
         validate_fov(fov_degrees)?;
         base.validate(true)?;
-        // The fov spans the default window's half-extent h along its axis: s = h / tan(fov / 2)
-        // (pbrt's screen space); a screen window given in the scene is a window onto it.
-        let default = ScreenWindow::default_for(base.film.resolution());
-        let half_extent = f64::from(fov_axis.half_extent(default));
-        let scale = half_extent / (0.5 * f64::from(fov_degrees)).to_radians().tan();
+        let scale = fov_axis.perspective_scale(base.film.resolution(), fov_degrees);
         if !(scale as f32).is_finite() || scale as f32 <= 0.0 {
             return Err(CameraError::Fov { got: fov_degrees });
         }

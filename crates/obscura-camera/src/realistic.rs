@@ -586,13 +586,20 @@ impl RealisticCamera {
         m
     }
 
-    /// The fraction of light the stop passes at a point of its plane: 0 outside its circle
-    /// (stopped down), else the aperture's transmission there ([`Aperture::transmission`], in
-    /// units of the stop's radius).
-    fn stop_transmission(&self, p: DVec2) -> f64 {
+    /// The fraction of light the stop passes at a point of its plane, as `clip` tests it:
+    /// 1 without clipping; else 0 outside its (stopped-down) circle, and inside it 1 for
+    /// [`Clip::Circles`] or the aperture's transmission for [`Clip::Stop`]
+    /// ([`Aperture::transmission`], in units of the stop's radius).
+    fn stop_passes(&self, p: DVec2, clip: Clip) -> f64 {
+        if clip == Clip::No {
+            return 1.0;
+        }
         let r = self.elements[self.stop].aperture_radius;
         if p.length_squared() > r * r {
             return 0.0;
+        }
+        if clip == Clip::Circles {
+            return 1.0;
         }
         f64::from(self.lens.aperture.transmission((p / r).as_vec2()))
     }
@@ -609,18 +616,7 @@ impl RealisticCamera {
             }
             let t = (e.z - ray.o.z) / ray.d.z;
             let p = ray.o + t * ray.d;
-            let passed = match clip {
-                Clip::No => 1.0,
-                Clip::Circles => {
-                    let r = e.aperture_radius;
-                    if p.truncate().length_squared() <= r * r {
-                        1.0
-                    } else {
-                        0.0
-                    }
-                }
-                Clip::Stop => self.stop_transmission(p.truncate()),
-            };
+            let passed = self.stop_passes(p.truncate(), clip);
             if t < 0.0 || passed <= 0.0 {
                 return None;
             }

@@ -88,8 +88,7 @@ impl StereoRig {
         fov_axis: FovAxis,
         resolution: [u32; 2],
     ) -> Result<ScreenWindow, CameraError> {
-        let half_extent = f64::from(fov_axis.half_extent(ScreenWindow::default_for(resolution)));
-        let scale = half_extent / (0.5 * f64::from(fov_degrees)).to_radians().tan();
+        let scale = fov_axis.perspective_scale(resolution, fov_degrees);
         let shift = (-scale * f64::from(self.offset(eye)) / f64::from(self.convergence)) as f32;
         ScreenWindow::new(
             window.x_min + shift,

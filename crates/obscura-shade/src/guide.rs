@@ -260,11 +260,7 @@ fn bounding_sphere(shape: &Shape, world_from_object: &Transform<World, Object>) 
     {
         return finite(c, r);
     }
-    let b = world_from_object.bounds(shape.object_bounds());
-    finite(
-        b.centroid().to_glam(),
-        0.5 * b.diagonal().to_glam().length(),
-    )
+    box_sphere(world_from_object.bounds(shape.object_bounds()), 0.0)
 }
 
 /// A sphere that holds `shape` over all of its motion. For a sphere placed by similarities at
@@ -282,17 +278,17 @@ fn swept_sphere(
             .collect();
         if let Some(largest) = radii.and_then(|r| r.into_iter().reduce(f32::max)) {
             let c = Point3::from_glam(*center);
-            let path = world_from_object.motion_bounds(Bounds3::new(c, c));
-            return finite(
-                path.centroid().to_glam(),
-                0.5 * path.diagonal().to_glam().length() + largest,
-            );
+            return box_sphere(world_from_object.motion_bounds(Bounds3::new(c, c)), largest);
         }
     }
-    let b = world_from_object.motion_bounds(shape.object_bounds());
+    box_sphere(world_from_object.motion_bounds(shape.object_bounds()), 0.0)
+}
+
+/// The sphere through the corners of `b`, its radius grown by `grow`.
+fn box_sphere(b: Bounds3<World>, grow: f32) -> Option<Caster> {
     finite(
         b.centroid().to_glam(),
-        0.5 * b.diagonal().to_glam().length(),
+        0.5 * b.diagonal().to_glam().length() + grow,
     )
 }
 

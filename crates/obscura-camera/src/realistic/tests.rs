@@ -456,7 +456,7 @@ fn stopped_down(aperture: Aperture) -> RealisticCamera {
 fn the_stop_is_the_samplers_polygon() {
     let camera = stopped_down(Aperture::polygon(6, 15.0).unwrap());
     let r = 4.0;
-    let inside = |p: DVec2| camera.stop_transmission(p) > 0.0;
+    let inside = |p: DVec2| camera.stop_passes(p, Clip::Stop) > 0.0;
     for i in 0..32 {
         for j in 0..32 {
             let u = glam::Vec2::new((i as f32 + 0.5) / 32.0, (j as f32 + 0.5) / 32.0);
@@ -505,9 +505,18 @@ fn an_image_stop_passes_light_in_proportion_to_its_weights() {
     let image = ApertureImage::new(&[1.0, 0.5], 2, 1).unwrap();
     let camera = stopped_down(Aperture::image(image));
     let r = 4.0;
-    assert_eq!(camera.stop_transmission(DVec2::new(-0.5 * r, 0.2)), 1.0);
-    assert_eq!(camera.stop_transmission(DVec2::new(0.5 * r, -0.2)), 0.5);
-    assert_eq!(camera.stop_transmission(DVec2::new(-0.8 * r, 0.8 * r)), 0.0);
+    assert_eq!(
+        camera.stop_passes(DVec2::new(-0.5 * r, 0.2), Clip::Stop),
+        1.0
+    );
+    assert_eq!(
+        camera.stop_passes(DVec2::new(0.5 * r, -0.2), Clip::Stop),
+        0.5
+    );
+    assert_eq!(
+        camera.stop_passes(DVec2::new(-0.8 * r, 0.8 * r), Clip::Stop),
+        0.0
+    );
     // The same rays as through the round stop of the same size (its circle bounds the
     // pupil alike), each weighted by its half's transmission over the mean transmission
     // (both normalise the film centre to 1): 1 / 0.75 on the left, 0.5 / 0.75 on the right.
@@ -546,9 +555,9 @@ fn an_anamorphic_stop_is_an_oval() {
     // 4 (y). The exit-pupil bounds stay the round stop's: they are turned to each film
     // point's azimuth, which only a round outline survives.
     let camera = stopped_down(Aperture::CIRCLE.with_anamorphic(2.0).unwrap());
-    assert_eq!(camera.stop_transmission(DVec2::new(1.9, 0.0)), 1.0);
-    assert_eq!(camera.stop_transmission(DVec2::new(2.1, 0.0)), 0.0);
-    assert_eq!(camera.stop_transmission(DVec2::new(0.0, 3.9)), 1.0);
+    assert_eq!(camera.stop_passes(DVec2::new(1.9, 0.0), Clip::Stop), 1.0);
+    assert_eq!(camera.stop_passes(DVec2::new(2.1, 0.0), Clip::Stop), 0.0);
+    assert_eq!(camera.stop_passes(DVec2::new(0.0, 3.9), Clip::Stop), 1.0);
     let size = camera.bounds[0].max - camera.bounds[0].min;
     assert!((size.x / size.y - 1.0).abs() < 0.05, "{size}");
     // Every ray from the film centre crosses the stop inside the ellipse.
