@@ -101,9 +101,19 @@ pub enum CameraError {
         /// The angles given, about camera x then y.
         got: [f32; 2],
     },
+    /// A realistic camera's tilted plane of focus that its lens cannot focus on the film
+    /// (part of the plane the tilt fit looks at lies inside the lens's closest focus).
+    #[error(
+        "focal_plane_tilt [{}, {}]: the lens cannot focus this tilted plane (it comes closer than the lens's nearest focus); tilt less or focus farther",
+        got[0], got[1]
+    )]
+    TiltOutOfReach {
+        /// The angles given, about camera x then y.
+        got: [f32; 2],
+    },
     /// A focal-plane tilt on a camera that cannot tilt it.
     #[error(
-        "focal_plane_tilt needs a perspective camera with a thin lens (lens_radius > 0): a pinhole or another model has no plane of focus to tilt"
+        "focal_plane_tilt needs a perspective camera with a thin lens (lens_radius > 0) or a realistic camera: a pinhole or another model has no plane of focus to tilt"
     )]
     TiltWithoutLens,
     /// An exposure setting out of range.

@@ -206,6 +206,11 @@ pub struct RealisticLens {
     /// relative to the brightest, cut to the stop's circle: rays through a dimmer part carry
     /// less light.
     pub aperture: Aperture,
+    /// The plane of focus's tilt in degrees about camera x and camera y, each in (-90, 90)
+    /// (`[0, 0]` for none): the plane in focus becomes `z = focus_distance + y tan(a) +
+    /// x tan(b)` in camera space, z measured from the film, as for a tilted
+    /// [`ThinLens`](crate::ThinLens). The film is tilted to that plane's image (Scheimpflug).
+    pub focal_plane_tilt: [f32; 2],
 }
 
 impl Default for RealisticLens {
@@ -215,6 +220,7 @@ impl Default for RealisticLens {
             focus_distance: 10.0,
             film_diagonal: DEFAULT_FILM_DIAGONAL,
             aperture: Aperture::CIRCLE,
+            focal_plane_tilt: [0.0, 0.0],
         }
     }
 }
@@ -311,11 +317,19 @@ impl PupilBound {
 ///   vertex plane that holds every rear point through which a ray from the segment's film
 ///   points gets through, grown by one grid cell; a film point off the axis rotates its
 ///   segment's rectangle to its azimuth.
-/// - Weight: `cos^4(theta) A / (delta^2 E_0)` with `theta` the ray's angle to the axis, `A` the
-///   bound's area (the inverse of the sample's density), `delta` the rear vertex's distance
-///   from the film, and `E_0` the film centre's irradiance from a uniform unit sky, the same
-///   integral over the rear plane estimated at construction. So a uniform white sky gives 1 at
-///   the image centre and the lens's relative illumination elsewhere (vignetting included).
+/// - Weight: `cos^4(theta) A / (Delta^2 E_0)` with `theta` the ray's angle to the axis, `A` the
+///   bound's area (the inverse of the sample's density), `Delta` the film point's distance
+///   from the rear vertex's plane (`delta` at the film centre), and `E_0` the film centre's
+///   irradiance from a uniform unit sky, the same integral over the rear plane estimated at
+///   construction. So a uniform white sky gives 1 at the image centre and the lens's relative
+///   illumination elsewhere (vignetting included).
+/// - Tilt (`focal_plane_tilt = [a, b]`): the plane in focus `z = F + y tan(a) + x tan(b)` is
+///   imaged onto a tilted film `z = s_x x + s_y y` (Scheimpflug). Each slope is measured by
+///   tracing: the best-focus images (least RMS spread of a traced bundle) of two points of
+///   the plane on either side of the axis, the slope of the line through them. Paraxially
+///   `s = m tan`, `m` the lateral magnification. Film positions keep their `(x, y)`, so the
+///   raster maps to the film's projection on the plane z = 0. The exit-pupil bounds hold film
+///   points at the ends of the depths a segment's radius reaches.
 ///
 /// `project` finds the chief ray through the stop's centre (secant on the stop height, from
 /// a paraxial estimate through the entrance pupil, to [`PROJECT_TOLERANCE_MM`]) and traces it
@@ -332,8 +346,11 @@ pub struct RealisticCamera {
     film_size: DVec2,
     /// Half the film diagonal (mm): the largest film radius.
     film_radius: f64,
-    /// The rear vertex's distance from the film (mm).
+    /// The rear vertex's distance from the film centre (mm).
     film_distance: f64,
+    /// The film's slopes: film point `(x, y)` lies at `z = tilt.x x + tilt.y y` (zero when
+    /// the plane of focus is not tilted).
+    tilt: DVec2,
     bounds: Vec<PupilBound>,
     /// `delta^2 / (delta^2 E_0) = 1 / E_0` with `E_0` as `centre_irradiance` gives it (the
     /// integral of `cos^4`, without the `1 / delta^2` both share): the weight's constant.
@@ -377,6 +394,10 @@ impl RealisticCamera {
             });
         }
         lens.aperture.validate()?;
+        let tilt = lens.focal_plane_tilt;
+        if !tilt.iter().all(|a| a.is_finite() && a.abs() < 90.0) {
+            return Err(CameraError::FocalPlaneTilt { got: tilt });
+        }
         let focus_mm = f64::from(lens.focus_distance) * MM_PER_UNIT;
         if lens.focus_distance <= 0.0 {
             return Err(CameraError::FocusDistance {
@@ -424,6 +445,7 @@ impl RealisticCamera {
             film_size,
             film_radius: 0.5 * diagonal,
             film_distance: 0.0,
+            tilt: DVec2::ZERO,
             bounds: Vec::new(),
             weight_scale: 0.0,
             focal_length: 0.0,
@@ -466,6 +488,13 @@ impl RealisticCamera {
             return Err(CameraError::FocusDistance {
                 got: lens.focus_distance,
             });
+        }
+
+        if tilt != [0.0, 0.0] {
+            let [a, b] = tilt.map(|d| f64::from(d).to_radians().tan());
+            camera.tilt = camera
+                .film_slopes(focus_mm, DVec2::new(b, a))
+                .ok_or(CameraError::TiltOutOfReach { got: tilt })?;
         }
 
         // Exit-pupil bounds, then the weights' normaliser at the film centre.
@@ -683,13 +712,105 @@ impl RealisticCamera {
         Some((ray, passed))
     }
 
-    /// The ray from film point `film` (mm, z = 0) towards rear-plane point `rear`.
-    fn film_ray(&self, film: DVec2, rear: DVec2) -> LensRay {
-        let o = film.extend(0.0);
+    /// The film point (mm) at film position `film`: on the plane z = 0, or on the tilted
+    /// film's plane.
+    fn film_at(&self, film: DVec2) -> DVec3 {
+        film.extend(self.tilt.dot(film))
+    }
+
+    /// The ray from film point `o` (mm) towards rear-plane point `rear`.
+    fn film_ray(&self, o: DVec3, rear: DVec2) -> LensRay {
         LensRay {
             o,
             d: (rear.extend(self.film_distance) - o).normalize(),
         }
+    }
+
+    /// The rays of a bundle from the scene point `object` (mm) aimed over a disc a little
+    /// wider than the entrance pupil, traced to the film side: each as the line `a + z b` of
+    /// its xy against z. Empty when the lens has no entrance pupil.
+    fn bundle(&self, object: DVec3) -> Vec<(DVec2, DVec2)> {
+        let Some((pupil_z, pupil_radius)) = self.pupil(true) else {
+            return Vec::new();
+        };
+        let reach = 1.2 * pupil_radius;
+        let g = |k: usize| ((k as f64 + 0.5) / FOCUS_GRID as f64 * 2.0 - 1.0) * reach;
+        let mut lines = Vec::with_capacity(FOCUS_GRID * FOCUS_GRID);
+        for i in 0..FOCUS_GRID {
+            for j in 0..FOCUS_GRID {
+                let target = DVec3::new(g(i), g(j), pupil_z);
+                let ray = LensRay {
+                    o: object,
+                    d: (target - object).normalize(),
+                };
+                let Some((out, _)) = self.trace_from_scene(ray, Clip::Stop) else {
+                    continue;
+                };
+                if out.d.z >= 0.0 {
+                    continue;
+                }
+                let slope = out.d.truncate() / out.d.z;
+                lines.push((out.o.truncate() - out.o.z * slope, slope));
+            }
+        }
+        lines
+    }
+
+    /// The best-focus image (mm) of the scene point `object`: where its bundle's rays are
+    /// least spread about their centroid (least squares over z), and the centroid there.
+    fn best_image(&self, object: DVec3) -> Option<DVec3> {
+        let lines = self.bundle(object);
+        if lines.len() < 4 {
+            return None;
+        }
+        let n = lines.len() as f64;
+        let (a0, b0) = lines
+            .iter()
+            .fold((DVec2::ZERO, DVec2::ZERO), |(a, b), (la, lb)| {
+                (a + *la, b + *lb)
+            });
+        let (a0, b0) = (a0 / n, b0 / n);
+        let (ab, bb) = lines.iter().fold((0.0, 0.0), |(ab, bb), (a, b)| {
+            let (a, b) = (*a - a0, *b - b0);
+            (ab + a.dot(b), bb + b.dot(b))
+        });
+        let z = -ab / bb;
+        (bb > 0.0 && z.is_finite()).then(|| (a0 + z * b0).extend(z))
+    }
+
+    /// The film's slopes (`tilt`) for the plane of focus `z = focus_mm + slopes.x x +
+    /// slopes.y y`: along each axis, the slope of the line through the best-focus images of
+    /// two points of that plane seen on either side of the axis. The two points sit on the
+    /// lines from the entrance pupil's centre at field slope `+-w` (0.4 of the film radius
+    /// over the focal length, less where the plane is steep), so a curvature of the field,
+    /// which moves both images alike, drops out. Paraxially this is Scheimpflug's rule: the
+    /// image plane's slope is the lateral magnification times the object plane's. None
+    /// when a point lies inside the lens or has no real image behind the rear element.
+    fn film_slopes(&self, focus_mm: f64, slopes: DVec2) -> Option<DVec2> {
+        let (pupil_z, _) = self.pupil(true)?;
+        let front_z = self.elements[0].z;
+        let mut out = DVec2::ZERO;
+        for axis in 0..2 {
+            let s = slopes[axis];
+            let w = (0.4 * self.film_radius / self.focal_length.abs()).min(0.25 / s.abs());
+            let dir = if axis == 0 { DVec2::X } else { DVec2::Y };
+            let mut images = [DVec3::ZERO; 2];
+            for (image, side) in images.iter_mut().zip([-1.0, 1.0]) {
+                // From the pupil's centre along (side w, 1): z = pupil_z + t meets the plane
+                // where pupil_z + t = focus_mm + s side w t.
+                let t = (focus_mm - pupil_z) / (1.0 - s * side * w);
+                let object = (dir * (side * w * t)).extend(pupil_z + t);
+                if !(t > 0.0 && object.z > front_z) {
+                    return None;
+                }
+                *image = self
+                    .best_image(object)
+                    .filter(|i| i.z < self.film_distance)?;
+            }
+            let across = (images[1] - images[0]).truncate().dot(dir);
+            out[axis] = (images[1].z - images[0].z) / across;
+        }
+        out.is_finite().then_some(out)
     }
 
     /// Best focus of the traced bundle from the axial point at `focus_mm`: moves the film by
@@ -697,37 +818,11 @@ impl RealisticCamera {
     /// lens changes the object distance a little).
     fn refine_focus(&mut self, focus_mm: f64) {
         for _ in 0..12 {
-            // The bundle aims at a disc a little wider than the entrance pupil.
-            let Some((pupil_z, pupil_radius)) = self.pupil(true) else {
-                return;
-            };
-            let object = DVec3::new(0.0, 0.0, focus_mm);
-            let reach = 1.2 * pupil_radius;
-            let (mut ab, mut bb) = (0.0, 0.0);
-            let mut count = 0;
-            for i in 0..FOCUS_GRID {
-                for j in 0..FOCUS_GRID {
-                    let g = |k: usize| ((k as f64 + 0.5) / FOCUS_GRID as f64 * 2.0 - 1.0) * reach;
-                    let target = DVec3::new(g(i), g(j), pupil_z);
-                    let ray = LensRay {
-                        o: object,
-                        d: (target - object).normalize(),
-                    };
-                    let Some((out, _)) = self.trace_from_scene(ray, Clip::Stop) else {
-                        continue;
-                    };
-                    if out.d.z >= 0.0 {
-                        continue;
-                    }
-                    // xy on the plane z: a + z b.
-                    let slope = out.d.truncate() / out.d.z;
-                    let a = out.o.truncate() - out.o.z * slope;
-                    ab += a.dot(slope);
-                    bb += slope.dot(slope);
-                    count += 1;
-                }
-            }
-            if count < 4 || bb == 0.0 {
+            let lines = self.bundle(DVec3::new(0.0, 0.0, focus_mm));
+            let (ab, bb) = lines.iter().fold((0.0, 0.0), |(ab, bb), (a, b)| {
+                (ab + a.dot(*b), bb + b.dot(*b))
+            });
+            if lines.len() < 4 || bb == 0.0 {
                 return;
             }
             let best = -ab / bb;
@@ -746,18 +841,29 @@ impl RealisticCamera {
     /// (1.5 times its clear aperture, as a ray may reach the curved element's aperture from
     /// outside it on the vertex plane) and over the paraxial exit pupil's footprint (which a
     /// small stop makes finer than that grid), then on a grid over what that found; grown by
-    /// a cell, since a ray between grid points may get through where none of them did.
+    /// a cell, since a ray between grid points may get through where none of them did. On a
+    /// tilted film a point at radius `r` lies anywhere within `r |tilt|` of the plane z = 0,
+    /// depending on its azimuth, so the film points are taken at both ends of that range and
+    /// in its middle.
     fn bound_segment(&self, k: usize) -> PupilBound {
-        let radii: Vec<f64> = (0..BOUND_RADII)
-            .map(|a| {
+        let depth = self.tilt.length();
+        let films: Vec<DVec3> = (0..BOUND_RADII)
+            .flat_map(|a| {
                 let t = (k as f64 + a as f64 / (BOUND_RADII - 1) as f64) / PUPIL_SEGMENTS as f64;
-                t * self.film_radius
+                let r = t * self.film_radius;
+                let heights: &[f64] = if depth > 0.0 {
+                    &[-1.0, 0.0, 1.0]
+                } else {
+                    &[0.0]
+                };
+                heights
+                    .iter()
+                    .map(move |h| DVec3::new(r, 0.0, h * r * depth))
             })
             .collect();
-        let scan = |bound: &mut PupilBound, radii: &[f64], min: DVec2, max: DVec2| -> f64 {
+        let scan = |bound: &mut PupilBound, films: &[DVec3], min: DVec2, max: DVec2| -> f64 {
             let cell = (max - min) / BOUND_GRID as f64;
-            for &r in radii {
-                let film = DVec2::new(r, 0.0);
+            for &film in films {
                 for i in 0..BOUND_GRID {
                     for j in 0..BOUND_GRID {
                         let q = min + cell * DVec2::new(i as f64 + 0.5, j as f64 + 0.5);
@@ -775,14 +881,17 @@ impl RealisticCamera {
         // First pass: the rear element, and the exit pupil's footprint for each radius.
         let rear = 1.5 * self.elements[self.elements.len() - 1].aperture_radius;
         let mut coarse = PupilBound::EMPTY;
-        let mut cell = scan(&mut coarse, &radii, DVec2::splat(-rear), DVec2::splat(rear));
-        if let Some((z, radius)) = self.pupil(false).filter(|(z, _)| z.abs() > 1e-9) {
-            // The cone from the film point (z = 0) to the pupil disc at z, on the rear plane.
-            let scale = self.film_distance / z;
-            for &r in &radii {
-                let centre = DVec2::new(r * (1.0 - scale), 0.0);
+        let mut cell = scan(&mut coarse, &films, DVec2::splat(-rear), DVec2::splat(rear));
+        if let Some((z, radius)) = self.pupil(false) {
+            for &film in &films {
+                // The cone from the film point to the pupil disc at z, on the rear plane.
+                if (z - film.z).abs() <= 1e-9 {
+                    continue;
+                }
+                let scale = (self.film_distance - film.z) / (z - film.z);
+                let centre = DVec2::new(film.x * (1.0 - scale), 0.0);
                 let half = DVec2::splat(1.5 * radius * scale.abs() + 1e-6);
-                let footprint = scan(&mut coarse, &[r], centre - half, centre + half);
+                let footprint = scan(&mut coarse, &[film], centre - half, centre + half);
                 cell = cell.max(footprint.min(cell));
             }
         }
@@ -795,7 +904,7 @@ impl RealisticCamera {
             coarse.max + DVec2::splat(cell),
         );
         let mut fine = coarse;
-        let fine_cell = scan(&mut fine, &radii, min, max);
+        let fine_cell = scan(&mut fine, &films, min, max);
         let grow = DVec2::splat(fine_cell);
         PupilBound {
             min: fine.min - grow,
@@ -816,7 +925,7 @@ impl RealisticCamera {
         for i in 0..NORMALISER_GRID {
             for j in 0..NORMALISER_GRID {
                 let q = b.min + size * DVec2::new(i as f64 + 0.5, j as f64 + 0.5);
-                let ray = self.film_ray(DVec2::ZERO, q);
+                let ray = self.film_ray(DVec3::ZERO, q);
                 if let Some((_, passed)) = self.trace_from_film(ray, Clip::Stop) {
                     sum += ray.d.z.powi(4) * passed;
                 }
@@ -852,10 +961,13 @@ impl RealisticCamera {
         let q = bound.min + (bound.max - bound.min) * u.as_dvec2();
         let azimuth = if r > 0.0 { film / r } else { DVec2::X };
         let rear = azimuth.rotate(q);
-        // Trace; weight cos^4(theta) A T / (delta^2 E_0), T the light the stop passes.
-        let ray = self.film_ray(film, rear);
+        // Trace; weight cos^4(theta) A T / (Delta^2 E_0), T the light the stop passes and
+        // Delta the film point's distance from the rear plane (delta, but on a tilted film).
+        let o = self.film_at(film);
+        let ray = self.film_ray(o, rear);
         let (out, passed) = self.trace_from_film(ray, Clip::Stop)?;
-        let weight = ray.d.z.powi(4) * bound.area() * passed * self.weight_scale;
+        let near = self.film_distance / (self.film_distance - o.z);
+        let weight = ray.d.z.powi(4) * bound.area() * passed * self.weight_scale * near * near;
         Some((out, weight))
     }
 
@@ -942,7 +1054,8 @@ impl RealisticCamera {
         } else {
             0.0
         };
-        let ray_to = |h: f64| self.film_ray(film, axis * h);
+        let o = self.film_at(film);
+        let ray_to = |h: f64| self.film_ray(o, axis * h);
         let height = |h: f64| -> Option<f64> {
             self.stop_height(ray_to(h), (self.stop..n).rev(), axis)
                 .map(|(s, _)| s)
@@ -1030,10 +1143,13 @@ impl RealisticCamera {
         for i in self.stop + 1..self.elements.len() {
             self.interact(i, &mut ray, Clip::No)?;
         }
-        if ray.d.z >= 0.0 {
+        // Where the ray meets the film: z = tilt . xy, i.e. (-tilt, 1) . p = 0.
+        let normal = (-self.tilt).extend(1.0);
+        let towards = normal.dot(ray.d);
+        if towards >= 0.0 {
             return None;
         }
-        let t = -ray.o.z / ray.d.z;
+        let t = -normal.dot(ray.o) / towards;
         Some((ray.o + t * ray.d).truncate())
     }
 }

@@ -364,6 +364,7 @@ pub(crate) fn build_camera(
                 focus_distance: r.focus_distance,
                 film_diagonal: r.film_diagonal,
                 aperture: c.lens.aperture.clone(),
+                focal_plane_tilt: r.focal_plane_tilt,
             };
             RealisticCamera::new(base, &r.prescription, lens)?.into()
         }

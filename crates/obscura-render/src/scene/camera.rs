@@ -88,9 +88,9 @@ pub(crate) fn camera_key(e: &CameraError) -> &'static str {
         CameraError::RollingReadout { .. } | CameraError::UnknownRollingDirection(_) => {
             "camera.rolling_shutter"
         }
-        CameraError::FocalPlaneTilt { .. } | CameraError::TiltWithoutLens => {
-            "camera.focal_plane_tilt"
-        }
+        CameraError::FocalPlaneTilt { .. }
+        | CameraError::TiltOutOfReach { .. }
+        | CameraError::TiltWithoutLens => "camera.focal_plane_tilt",
         CameraError::Exposure { what, .. } => match *what {
             "f_number" => "camera.f_number",
             "shutter_time" => "camera.shutter_time",
@@ -115,7 +115,7 @@ fn reads(kind: CameraKind, key: &str) -> bool {
             matches!(kind, Perspective | Orthographic | Realistic)
         }
         "lens_file" | "aperture_diameter" | "focus_distance" | "film_diagonal" => kind == Realistic,
-        "focal_plane_tilt" => kind == Perspective,
+        "focal_plane_tilt" => matches!(kind, Perspective | Realistic),
         "lens_shift" => matches!(kind, Perspective | Orthographic | Fisheye),
         "fx" | "fy" | "cx" | "cy" | "distortion" => matches!(kind, OpenCv | OpenCvFisheye),
         "projection" => kind == Fisheye,
@@ -349,6 +349,7 @@ impl Cx<'_> {
             Some(self.realistic(
                 c.lens_file,
                 [c.aperture_diameter, c.focus_distance, c.film_diagonal],
+                c.focal_plane_tilt,
                 base,
             )?)
         } else {
@@ -476,6 +477,7 @@ impl Cx<'_> {
         &self,
         lens_file: Option<String>,
         numbers: [Option<f32>; 3],
+        focal_plane_tilt: Option<[f32; 2]>,
         base: &Path,
     ) -> Result<RealisticSettings, RenderError> {
         let [aperture_diameter, focus_distance, film_diagonal] = numbers;
@@ -507,6 +509,7 @@ impl Cx<'_> {
             aperture_diameter,
             focus_distance,
             film_diagonal,
+            focal_plane_tilt: focal_plane_tilt.unwrap_or([0.0, 0.0]),
         })
     }
 

@@ -356,6 +356,9 @@ pub struct RealisticSettings {
     pub focus_distance: f32,
     /// `film_diagonal` (mm).
     pub film_diagonal: f32,
+    /// `focal_plane_tilt` (degrees about camera x and y; `[0, 0]` for none): the realistic
+    /// camera tilts its film to the tilted plane's image.
+    pub focal_plane_tilt: [f32; 2],
 }
 
 impl SceneDescription {
