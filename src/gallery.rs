@@ -61,7 +61,7 @@ macro_rules! figure {
 }
 
 /// Every figure the gallery makes, in order.
-pub const FIGURES: [Figure; 25] = [
+pub const FIGURES: [Figure; 26] = [
     figure!("projection-perspective"),
     figure!("projection-orthographic"),
     figure!("dof-lens-radius"),
@@ -87,6 +87,7 @@ pub const FIGURES: [Figure; 25] = [
     figure!("realistic-apertures"),
     figure!("rolling-shutter"),
     figure!("tilt-shift"),
+    figure!("realistic-tilt"),
 ];
 
 /// The `realistic-lenses` row: each lens file (written into `lenses/` beside the scene), its
@@ -113,8 +114,8 @@ pub const LENS_PANELS: [(&str, &str, f32); 3] = [
 /// The aperture image the `aperture-bokeh` figure reads, written beside its scene.
 pub const APERTURE_IMAGE: &str = "aperture-star.png";
 
-/// The `tilt-shift` row: the focal plane's tilt about camera x in each panel (the camera looks
-/// down at 32.47 degrees, so 57.53 lays the plane in the ground).
+/// The `tilt-shift` and `realistic-tilt` rows: the focal plane's tilt about camera x in each
+/// panel (the camera looks down at 32.47 degrees, so 57.53 lays the plane in the ground).
 pub const TILT_PANELS: [f32; 3] = [0.0, 57.53, -57.53];
 
 /// The `fisheye-projections` row: each projection and its field of view in degrees (the
@@ -344,11 +345,14 @@ fn make_figure(out_dir: &Path, figure: Figure, quality: Quality) -> Result<Made,
             global.camera.timing = ShutterTiming::default();
             vec![shoot(instant)?, shoot(global)?, shoot(base)?]
         }
-        "tilt-shift" => TILT_PANELS
+        "tilt-shift" | "realistic-tilt" => TILT_PANELS
             .iter()
             .map(|&tilt| {
                 let mut d = base.clone();
-                d.camera.lens.focal_plane_tilt = [tilt, 0.0];
+                match d.camera.realistic.as_mut() {
+                    Some(r) => r.focal_plane_tilt = [tilt, 0.0],
+                    None => d.camera.lens.focal_plane_tilt = [tilt, 0.0],
+                }
                 shoot(d)
             })
             .collect::<Result<_, _>>()?,
