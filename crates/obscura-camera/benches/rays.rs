@@ -80,6 +80,24 @@ fn cameras(moving: bool) -> Vec<(String, AnyCamera)> {
             .unwrap()
             .into(),
         ),
+        (
+            // The film tilted for a plane of focus at 0.5 m tilted by 30 degrees.
+            format!("realistic double gauss tilted{suffix}"),
+            RealisticCamera::new(
+                base(),
+                &LensPrescription::parse(include_str!(
+                    "../../../scenes/lenses/double-gauss-50mm.dat"
+                ))
+                .unwrap(),
+                RealisticLens {
+                    focus_distance: 0.5,
+                    focal_plane_tilt: [30.0, 0.0],
+                    ..RealisticLens::default()
+                },
+            )
+            .unwrap()
+            .into(),
+        ),
     ]
 }
 
