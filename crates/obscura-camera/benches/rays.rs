@@ -66,39 +66,30 @@ fn cameras(moving: bool) -> Vec<(String, AnyCamera)> {
         ),
         (
             format!("realistic double gauss{suffix}"),
-            RealisticCamera::new(
-                base(),
-                &LensPrescription::parse(include_str!(
-                    "../../../scenes/lenses/double-gauss-50mm.dat"
-                ))
-                .unwrap(),
-                RealisticLens {
-                    focus_distance: 5.0,
-                    ..RealisticLens::default()
-                },
-            )
-            .unwrap()
-            .into(),
+            double_gauss(base(), 5.0, [0.0, 0.0]),
         ),
         (
             // The film tilted for a plane of focus at 0.5 m tilted by 30 degrees.
             format!("realistic double gauss tilted{suffix}"),
-            RealisticCamera::new(
-                base(),
-                &LensPrescription::parse(include_str!(
-                    "../../../scenes/lenses/double-gauss-50mm.dat"
-                ))
-                .unwrap(),
-                RealisticLens {
-                    focus_distance: 0.5,
-                    focal_plane_tilt: [30.0, 0.0],
-                    ..RealisticLens::default()
-                },
-            )
-            .unwrap()
-            .into(),
+            double_gauss(base(), 0.5, [30.0, 0.0]),
         ),
     ]
+}
+
+/// The shipped double Gauss focused at `focus` metres, its plane of focus tilted by `tilt`.
+fn double_gauss(base: CameraBase, focus: f32, tilt: [f32; 2]) -> AnyCamera {
+    let lens = include_str!("../../../scenes/lenses/double-gauss-50mm.dat");
+    RealisticCamera::new(
+        base,
+        &LensPrescription::parse(lens).unwrap(),
+        RealisticLens {
+            focus_distance: focus,
+            focal_plane_tilt: tilt,
+            ..RealisticLens::default()
+        },
+    )
+    .unwrap()
+    .into()
 }
 
 /// One sample per pixel of the image, with lens and time samples spread over [0, 1).

@@ -260,9 +260,17 @@ fn camera_stopped(text: &str, focus: f32, aperture: f64) -> RealisticCamera {
     )
 }
 
-/// The RMS distance from their centroid at which rays of one film point cross the plane in
-/// focus (world z = -focus), over a grid of lens samples.
-fn spot_rms(camera: &RealisticCamera, p: Point2<Raster>, focus: f32) -> (f64, usize) {
+/// The RMS distance from their centroid at which the camera's rays of raster point `p` cross
+/// the plane `z = focus + y tan(a) + x tan(b)` for `tilt = [a, b]` in degrees (camera space,
+/// metres from the film; the test cameras' camera space is world space with z negated), over
+/// a grid of lens samples; and how many rays there were.
+fn spot_on_plane(
+    camera: &RealisticCamera,
+    p: Point2<Raster>,
+    focus: f64,
+    tilt: [f64; 2],
+) -> (f64, usize) {
+    let [ta, tb] = tilt.map(|d| d.to_radians().tan());
     let mut points = Vec::new();
     let n = 48;
     for i in 0..n {
@@ -274,20 +282,26 @@ fn spot_rms(camera: &RealisticCamera, p: Point2<Raster>, focus: f32) -> (f64, us
                 time: 0.0,
             };
             if let Some(r) = camera.generate_ray(&sample) {
-                let o = r.ray.origin.to_glam().as_dvec3();
-                let d = r.ray.direction.to_glam().as_dvec3();
-                let t = (-f64::from(focus) - o.z) / d.z;
-                points.push((o + t * d).truncate());
+                let o = r.ray.origin.to_glam().as_dvec3() * DVec3::new(1.0, 1.0, -1.0);
+                let d = r.ray.direction.to_glam().as_dvec3() * DVec3::new(1.0, 1.0, -1.0);
+                // o + t d on z = focus + y ta + x tb.
+                let t = (focus + o.y * ta + o.x * tb - o.z) / (d.z - d.y * ta - d.x * tb);
+                points.push(o + t * d);
             }
         }
     }
-    let centroid = points.iter().sum::<DVec2>() / points.len() as f64;
+    let centroid = points.iter().sum::<DVec3>() / points.len() as f64;
     let ms = points
         .iter()
         .map(|p| (*p - centroid).length_squared())
         .sum::<f64>()
         / points.len() as f64;
     (ms.sqrt(), points.len())
+}
+
+/// [`spot_on_plane`] for the untilted plane z = `focus`.
+fn spot_rms(camera: &RealisticCamera, p: Point2<Raster>, focus: f32) -> (f64, usize) {
+    spot_on_plane(camera, p, f64::from(focus), [0.0, 0.0])
 }
 
 #[test]
@@ -708,40 +722,6 @@ fn steep() -> &'static RealisticCamera {
     })
 }
 
-/// The RMS distance from their centroid at which the camera's rays of raster point `p` cross
-/// the plane `z = focus + y tan(a) + x tan(b)` (camera space, metres from the film; the test
-/// cameras' camera space is world space with z negated), over a grid of lens samples.
-fn spot_on_plane(camera: &RealisticCamera, p: Point2<Raster>, focus: f64, tilt: [f64; 2]) -> f64 {
-    let [ta, tb] = tilt.map(|d| d.to_radians().tan());
-    let mut points = Vec::new();
-    let n = 32;
-    for i in 0..n {
-        for j in 0..n {
-            let u = glam::Vec2::new((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
-            let sample = CameraSample {
-                p_film: p,
-                p_lens: u,
-                time: 0.0,
-            };
-            if let Some(r) = camera.generate_ray(&sample) {
-                let o = r.ray.origin.to_glam().as_dvec3() * DVec3::new(1.0, 1.0, -1.0);
-                let d = r.ray.direction.to_glam().as_dvec3() * DVec3::new(1.0, 1.0, -1.0);
-                // o + t d on z = focus + y ta + x tb.
-                let t = (focus + o.y * ta + o.x * tb - o.z) / (d.z - d.y * ta - d.x * tb);
-                points.push(o + t * d);
-            }
-        }
-    }
-    assert!(points.len() > 200, "{} rays", points.len());
-    let centroid = points.iter().sum::<DVec3>() / points.len() as f64;
-    let ms = points
-        .iter()
-        .map(|p| (*p - centroid).length_squared())
-        .sum::<f64>()
-        / points.len() as f64;
-    ms.sqrt()
-}
-
 #[test]
 fn a_tilted_film_follows_scheimpflug() {
     // Paraxially the image of a plane tilted by slope s is tilted by m s, m the lateral
@@ -799,8 +779,12 @@ fn points_on_a_tilted_plane_image_to_points() {
             }
             // The world point of camera-space (x, y, 2 + depth).
             let world = Point3::new(x as f32, y as f32, -(2.0 + depth) as f32);
-            let sharp = spot_on_plane(&tilted, tilted.project(world, 0.0).unwrap(), 2.0, tilt);
-            let blurred = spot_on_plane(&flat, flat.project(world, 0.0).unwrap(), 2.0, tilt);
+            let spot = |c: &RealisticCamera| {
+                let (rms, count) = spot_on_plane(c, c.project(world, 0.0).unwrap(), 2.0, tilt);
+                assert!(count > 500, "{count} rays");
+                rms
+            };
+            let (sharp, blurred) = (spot(&tilted), spot(&flat));
             assert!(
                 sharp < 2.5e-4 && sharp < 0.4 * blurred,
                 "tilt {tilt:?}, point ({x}, {y}): RMS {sharp} m tilted, {blurred} m untilted"
