@@ -101,10 +101,11 @@ pub enum CameraError {
         /// The angles given, about camera x then y.
         got: [f32; 2],
     },
-    /// A realistic camera's tilted plane of focus that its lens cannot focus on the film
-    /// (part of the plane the tilt fit looks at lies inside the lens's closest focus).
+    /// A realistic camera's tilted plane of focus that its lens cannot image onto a film
+    /// behind it: the plane comes nearer than the lens can focus, or the film tilted to its
+    /// image would reach more than halfway to the rear element.
     #[error(
-        "focal_plane_tilt [{}, {}]: the lens cannot focus this tilted plane (it comes closer than the lens's nearest focus); tilt less or focus farther",
+        "focal_plane_tilt [{}, {}]: this lens cannot image the tilted plane onto a film behind it (the plane comes nearer than the lens can focus, or the film would have to tilt into the lens); tilt less or focus farther",
         got[0], got[1]
     )]
     TiltOutOfReach {

@@ -495,6 +495,12 @@ impl RealisticCamera {
             camera.tilt = camera
                 .film_slopes(focus_mm, DVec2::new(b, a))
                 .ok_or(CameraError::TiltOutOfReach { got: tilt })?;
+            // The film's corners may come at most halfway to the rear vertex (a film tilted
+            // by up to 45 degrees behind the double Gauss): nearer, its rays would start
+            // beside or inside the rear element.
+            if camera.film_radius * camera.tilt.length() > 0.5 * camera.film_distance {
+                return Err(CameraError::TiltOutOfReach { got: tilt });
+            }
         }
 
         // Exit-pupil bounds, then the weights' normaliser at the film centre.

@@ -173,6 +173,24 @@ fn bad_parameters_are_errors() {
     assert_eq!(camera.film_slopes(0.5 * front, DVec2::new(0.0, 1.0)), None);
     assert_eq!(camera.film_slopes(front + 1.0, DVec2::new(0.0, 1.0)), None);
     assert!(camera.film_slopes(2000.0, DVec2::new(0.0, 1.0)).is_some());
+    // A plane so steep that the film would tilt into the lens: at 2 m the double Gauss
+    // magnifies 0.026 times, so 89.9 degrees (a slope of 573) needs a film slope of about 15.
+    assert!(matches!(
+        with(RealisticLens {
+            focus_distance: 2.0,
+            focal_plane_tilt: [89.9, 0.0],
+            ..d.clone()
+        }),
+        Err(CameraError::TiltOutOfReach { .. })
+    ));
+    assert!(
+        with(RealisticLens {
+            focus_distance: 2.0,
+            focal_plane_tilt: [80.0, 0.0],
+            ..d.clone()
+        })
+        .is_ok()
+    );
     assert!(matches!(
         with(RealisticLens {
             focus_distance: f32::NAN,
