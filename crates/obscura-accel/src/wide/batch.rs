@@ -12,7 +12,7 @@
 //! shared with it), so every answer equals what [`WideBvh::closest`] or [`WideBvh::any`]
 //! gives for that ray.
 
-use super::layout::{LEAF, Node, Packet};
+use super::layout::{INDEX, LEAF, Node, PAIR, Packet};
 use super::stack::Stack;
 use super::traverse::{Any, Closest, Step};
 use super::{WideBvh, WideHit};
@@ -199,14 +199,15 @@ impl WideBvh {
 /// A ray's query in flight: the query, the ray's slot, and its stack.
 type Flight<Q> = (Q, usize, Stack<<Q as InTurns>::Entry>);
 
-/// Asks for the lines of the node or packet `r` names.
+/// Asks for the lines of the node or leaf (one packet or two) `r` names.
 #[inline(always)]
 fn ask(nodes: &[Node], packets: &[Packet], r: u32) {
     if r & LEAF == 0 {
         if let Some(node) = nodes.get(r as usize) {
             prefetch(node, size_of::<Node>() / 64 - 1);
         }
-    } else if let Some(packet) = packets.get((r & !LEAF) as usize) {
-        prefetch(packet, size_of::<Packet>() / 64 - 1);
+    } else if let Some(packet) = packets.get((r & INDEX) as usize) {
+        let count = 1 + usize::from(r & PAIR != 0);
+        prefetch(packet, count * size_of::<Packet>() / 64 - 1);
     }
 }

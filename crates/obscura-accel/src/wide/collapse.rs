@@ -2,7 +2,7 @@
 //! surface-area dynamic programme.
 
 use super::WideBvh;
-use super::layout::{ARITY, EMPTY, LEAF, Node, Packet, WIDTH};
+use super::layout::{ARITY, EMPTY, LEAF, Node, PAIR, Packet, WIDTH};
 use crate::pages::Pages;
 use glam::{Vec3A, Vec4};
 use obvhs::BvhBuildParams;
@@ -87,7 +87,7 @@ struct Collapse<'a> {
     bvh2: &'a Bvh2,
     tris: &'a [[Vec3A; 3]],
     ids: &'a [[u32; 2]],
-    /// Per binary node `n`, the collapse's decisions. `choice[n][0]`: 0 makes `n` a packet,
+    /// Per binary node `n`, the collapse's decisions. `choice[n][0]`: 0 makes `n` a leaf,
     /// `j > 0` makes it a wide node whose eight slots take `j` from its left subtree and
     /// `8 - j` from its right. `choice[n][k - 1]` for `k >= 2`: 0 puts `n` in one slot, `j > 0`
     /// spreads `n` over `k` slots, `j` from the left subtree and `k - j` from the right.
@@ -98,6 +98,9 @@ struct Collapse<'a> {
 /// (both cost about one memory round trip of three or four cache lines plus a little SIMD).
 const COST_NODE: f32 = 1.0;
 const COST_PACKET: f32 = 1.0;
+/// The extra cost of a leaf's second packet: its lines follow the first's, so they come with
+/// it rather than one round trip later, and what is left is its test.
+const COST_SECOND_PACKET: f32 = 0.5;
 
 impl<'a> Collapse<'a> {
     fn new(bvh2: &'a Bvh2, tris: &'a [[Vec3A; 3]], ids: &'a [[u32; 2]]) -> Self {
@@ -131,9 +134,9 @@ impl<'a> Collapse<'a> {
     }
 
     /// The optimal collapse under the surface area heuristic, by dynamic programming over the
-    /// binary tree (after Ylitie et al. 2017, with four-triangle packets as leaves):
+    /// binary tree (after Ylitie et al. 2017, with leaves of one or two four-triangle packets):
     /// `cost[n][k - 1]` is the least cost of covering `n`'s subtree with at most `k` slots of
-    /// its parent, each slot a packet (subtrees of at most four triangles) or a wide node.
+    /// its parent, each slot a leaf (a subtree of at most eight triangles) or a wide node.
     fn plan(bvh2: &Bvh2, preorder: &[u32], count: &[u32]) -> Vec<[u8; ARITY]> {
         let mut cost = vec![[0f32; ARITY]; bvh2.nodes.len()];
         let mut choice = vec![[0u8; ARITY]; bvh2.nodes.len()];
@@ -143,6 +146,8 @@ impl<'a> Collapse<'a> {
             let area = node.aabb.half_area();
             let as_packet = if count[i] as usize <= WIDTH {
                 area * COST_PACKET
+            } else if count[i] as usize <= 2 * WIDTH {
+                area * (COST_PACKET + COST_SECOND_PACKET)
             } else {
                 f32::INFINITY
             };
@@ -228,13 +233,15 @@ impl<'a> Collapse<'a> {
         root
     }
 
-    /// The reference a wide node stores for binary node `b2`: a packet for a small subtree,
-    /// else a fresh wide node queued for filling.
+    /// The reference a wide node stores for binary node `b2`: a leaf of one or two packets
+    /// for a small subtree, else a fresh wide node queued for filling.
     fn reference(&self, b2: u32, out: &mut Arrays, work: &mut Vec<(u32, u32)>) -> u32 {
         if self.choice[b2 as usize][0] == 0 {
-            let packet = self.packet(b2);
-            out.packets.push(packet);
-            LEAF | (out.packets.len() as u32 - 1)
+            let first = out.packets.len() as u32;
+            let packets = self.packets(b2);
+            let pair = if packets.len() == 2 { PAIR } else { 0 };
+            out.packets.extend(packets);
+            LEAF | pair | first
         } else {
             let wide = out.nodes.len() as u32;
             out.nodes.push(Node::EMPTY);
@@ -253,15 +260,18 @@ impl<'a> Collapse<'a> {
         kids
     }
 
-    /// The packet of the (at most four) triangles under binary node `b2`.
-    fn packet(&self, b2: u32) -> Packet {
-        let mut packet = Packet {
+    /// The packets of the (at most eight) triangles under binary node `b2`: the first four in
+    /// tree order, then the rest.
+    fn packets(&self, b2: u32) -> Vec<Packet> {
+        const EMPTY_PACKET: Packet = Packet {
             v0: [Vec4::ZERO; 3],
             e1: [Vec4::ZERO; 3],
             e2: [Vec4::ZERO; 3],
             ids: [[EMPTY; WIDTH]; 2],
             _pad: [0; 4],
         };
+        let mut packets = Vec::with_capacity(2);
+        let mut packet = EMPTY_PACKET;
         let mut lane = 0;
         let mut pending = vec![b2];
         while let Some(i) = pending.pop() {
@@ -273,6 +283,11 @@ impl<'a> Collapse<'a> {
             }
             let first = node.first_index as usize;
             for &prim in &self.bvh2.primitive_indices[first..first + node.prim_count as usize] {
+                if lane == WIDTH {
+                    packets.push(packet);
+                    packet = EMPTY_PACKET;
+                    lane = 0;
+                }
                 let [v0, v1, v2] = self.tris[prim as usize];
                 let (e1, e2) = (v1 - v0, v2 - v0);
                 for axis in 0..3 {
@@ -285,6 +300,7 @@ impl<'a> Collapse<'a> {
                 lane += 1;
             }
         }
-        packet
+        packets.push(packet);
+        packets
     }
 }

@@ -4,8 +4,12 @@
 use glam::Vec4;
 use obvhs::aabb::Aabb;
 
-/// Set in a child reference that names a leaf packet rather than a node.
+/// Set in a child reference that names a leaf rather than a node.
 pub(super) const LEAF: u32 = 1 << 31;
+/// Set in a leaf's reference when the leaf is two packets, the one named and the next.
+pub(super) const PAIR: u32 = 1 << 30;
+/// The bits of a leaf's reference that name its (first) packet.
+pub(super) const INDEX: u32 = !(LEAF | PAIR);
 /// The child reference of an unused lane (its box is empty, so it is never entered).
 pub(super) const EMPTY: u32 = u32::MAX;
 /// Children per node: two SIMD registers' worth.
@@ -20,7 +24,8 @@ pub(super) const WIDTH: usize = 4;
 pub(super) struct Node {
     /// `[min_x, max_x, min_y, max_y, min_z, max_z]`; an unused lane has min +inf, max -inf.
     pub(super) bounds: [[Vec4; 2]; 6],
-    /// A node index, `LEAF | packet index`, or `EMPTY`.
+    /// A node index, `LEAF | packet index` (with [`PAIR`] for a leaf of that packet and the
+    /// next), or `EMPTY`.
     pub(super) child: [u32; ARITY],
     /// Explicit padding to 256 bytes, so a node is plain bytes ([`Pages`] maps it).
     pub(super) _pad: [u32; 8],

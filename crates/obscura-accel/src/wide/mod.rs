@@ -4,10 +4,11 @@
 //! collapsed here into nodes of up to eight children whose boxes sit in structure-of-arrays
 //! form, one lane per child, so one ray tests eight boxes in two registers' worth of SSE
 //! instructions (written on glam's `Vec4`, four lanes to a register, with the ray's values
-//! kept splatted so a batch reloads them without shuffles). Leaves are *packets* of up to four
-//! triangles (their first vertices and edges, again one lane per triangle) tested together by
-//! a four-wide Möller–Trumbore. Which binary nodes become a wide node's children and which
-//! subtrees become packets is chosen by a surface-area dynamic programme over the whole binary
+//! kept splatted so a batch reloads them without shuffles). Leaves are one or two *packets* of
+//! up to four triangles (their first vertices and edges, again one lane per triangle), each
+//! tested by a four-wide Möller–Trumbore; a leaf's two packets sit side by side, so their lines
+//! arrive together. Which binary nodes become a wide node's children and which subtrees become
+//! leaves is chosen by a surface-area dynamic programme over the whole binary
 //! tree (`Collapse::plan`).
 //!
 //! Why not obvhs's own traversal: its compressed wide BVH (CWBVH) unpacks eight quantised child

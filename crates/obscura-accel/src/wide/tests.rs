@@ -1,12 +1,30 @@
 //! The wide BVH against testing every triangle, and the slab test's rounding bounds.
 
 use super::WideBvh;
-use super::layout::{ARITY, EMPTY, LEAF, Node, WIDTH};
+use super::layout::{ARITY, EMPTY, INDEX, LEAF, Node, PAIR, WIDTH};
 use super::ray::{FAR_SCALE, slabs};
 use crate::geom::intersect_triangle;
 use glam::{Vec3, Vec3A};
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
+
+/// A bumpy square of `n` by `n` quads, two triangles each, across [-3, 3]^2 near z = 0.
+fn surface(n: usize) -> Vec<[Vec3A; 3]> {
+    let at = |i: usize, j: usize| {
+        let (x, y) = (
+            6.0 * i as f32 / n as f32 - 3.0,
+            6.0 * j as f32 / n as f32 - 3.0,
+        );
+        Vec3A::new(x, y, 0.3 * (1.7 * x).sin() * (1.3 * y).cos())
+    };
+    (0..n)
+        .flat_map(|i| (0..n).map(move |j| (i, j)))
+        .flat_map(|(i, j)| {
+            let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+            [[a, b, c], [a, c, d]]
+        })
+        .collect()
+}
 
 fn soup(n: usize, seed: u32) -> Vec<[Vec3A; 3]> {
     // A small deterministic generator: the tests need no statistical quality.
@@ -24,16 +42,19 @@ fn soup(n: usize, seed: u32) -> Vec<[Vec3A; 3]> {
 }
 
 /// Every input triangle sits in exactly one packet lane (no pre-splits), every node's lane
-/// box contains everything beneath it, and the stack bound covers the real depth.
+/// box contains everything beneath it, a two-packet leaf's second packet holds a triangle,
+/// and the stack bound covers the real depth.
 #[test]
 fn the_collapse_keeps_every_triangle_once_inside_its_boxes() {
-    for n in [1, 2, 4, 5, 17, 300] {
-        let tris = soup(n, n as u32);
+    let soups = [1, 2, 4, 5, 8, 9, 17, 300].map(|n| soup(n, n as u32));
+    for tris in soups.into_iter().chain([surface(24)]) {
+        let n = tris.len();
         let ids = (0..n as u32).map(|i| [i, i + 1000]).collect::<Vec<_>>();
         let bvh = WideBvh::build(&tris, &ids, BvhBuildParams::medium_build());
         let mut seen = vec![0u32; n];
         let mut pending = vec![(bvh.root, None::<[f32; 6]>, 0usize)];
         let mut depth_max = 0;
+        let mut pairs = 0;
         while let Some((r, bounds, depth)) = pending.pop() {
             depth_max = depth_max.max(depth);
             if r & LEAF == 0 {
@@ -52,8 +73,14 @@ fn the_collapse_keeps_every_triangle_once_inside_its_boxes() {
                     pending.push((node.child[lane], Some(b), depth + 1));
                 }
             } else {
-                let p = &bvh.packets[(r & !LEAF) as usize];
-                for lane in 0..WIDTH {
+                let first = (r & INDEX) as usize;
+                let count = 1 + usize::from(r & PAIR != 0);
+                pairs += count - 1;
+                assert!(count == 1 || bvh.packets[first + 1].ids[0][0] != EMPTY);
+                for (p, lane) in bvh.packets[first..first + count]
+                    .iter()
+                    .flat_map(|p| (0..WIDTH).map(move |lane| (p, lane)))
+                {
                     if p.ids[0][lane] == EMPTY {
                         continue;
                     }
@@ -72,8 +99,13 @@ fn the_collapse_keeps_every_triangle_once_inside_its_boxes() {
             }
         }
         assert!(seen.iter().all(|&s| s == 1), "n = {n}: {seen:?}");
-        if n > WIDTH {
-            assert!(bvh.root & LEAF == 0, "more than one packet needs a node");
+        if n > 2 * WIDTH {
+            assert!(bvh.root & LEAF == 0, "more than two packets need a node");
+        }
+        // A dense surface's small subtrees of five to eight triangles become two-packet
+        // leaves (scattered triangles' boxes are apart, and the heuristic splits them).
+        if n == 2 * 24 * 24 {
+            assert!(pairs > 20, "{pairs} two-packet leaves");
         }
     }
 }
@@ -106,6 +138,17 @@ fn queries_match_testing_every_triangle() {
         assert_eq!(lanes > tris.len(), params.pre_split, "{lanes} lanes");
         check_against_every_triangle(&tris, &bvh);
     }
+}
+
+/// A dense surface, whose tree has two-packet leaves, answers as testing every triangle does.
+#[test]
+fn a_tree_with_two_packet_leaves_answers_the_same() {
+    let tris = surface(24);
+    let ids = (0..tris.len() as u32).map(|i| [i, 7]).collect::<Vec<_>>();
+    check_against_every_triangle(
+        &tris,
+        &WideBvh::build(&tris, &ids, BvhBuildParams::medium_build()),
+    );
 }
 
 /// A tree large enough for its arrays to move to huge pages answers exactly as testing

@@ -1,6 +1,6 @@
 //! The queries: front-to-back closest hit and any hit, each over a per-thread stack.
 
-use super::layout::{ARITY, EMPTY, LEAF, Node, Packet};
+use super::layout::{ARITY, EMPTY, INDEX, LEAF, Node, PAIR, Packet};
 use super::ray::{Prepared, by_entry};
 use super::stack::Stack;
 use super::{WideBvh, WideHit};
@@ -177,26 +177,27 @@ impl<const SLACK: bool> Closest<SLACK> {
                 return true;
             }
         } else if current != EMPTY {
-            let index = (current & !LEAF) as usize;
-            let packet = &packets[index];
-            let (mask, t, b1, b2) = self.ray.triangles(packet, self.t_min, self.t_best);
-            if mask != 0 {
-                let (t, b1, b2) = (t.to_array(), b1.to_array(), b2.to_array());
-                let mut m = mask;
-                while m != 0 {
-                    let lane = m.trailing_zeros() as usize & 3;
-                    m &= m - 1;
-                    if t[lane] <= self.t_best {
-                        self.t_best = t[lane];
-                        self.best = Some((
-                            index,
-                            lane,
-                            TriangleHit {
-                                t: t[lane],
-                                b1: b1[lane],
-                                b2: b2[lane],
-                            },
-                        ));
+            for index in leaf_packets(current) {
+                let packet = &packets[index];
+                let (mask, t, b1, b2) = self.ray.triangles(packet, self.t_min, self.t_best);
+                if mask != 0 {
+                    let (t, b1, b2) = (t.to_array(), b1.to_array(), b2.to_array());
+                    let mut m = mask;
+                    while m != 0 {
+                        let lane = m.trailing_zeros() as usize & 3;
+                        m &= m - 1;
+                        if t[lane] <= self.t_best {
+                            self.t_best = t[lane];
+                            self.best = Some((
+                                index,
+                                lane,
+                                TriangleHit {
+                                    t: t[lane],
+                                    b1: b1[lane],
+                                    b2: b2[lane],
+                                },
+                            ));
+                        }
                     }
                 }
             }
@@ -281,9 +282,15 @@ impl<const SLACK: bool> Any<SLACK> {
                 return Step::Next;
             }
         } else if current != EMPTY {
-            let packet = &packets[(current & !LEAF) as usize];
-            if self.ray.triangles(packet, self.t_min, self.t_max).0 != 0 {
-                return Step::Hit;
+            for index in leaf_packets(current) {
+                if self
+                    .ray
+                    .triangles(&packets[index], self.t_min, self.t_max)
+                    .0
+                    != 0
+                {
+                    return Step::Hit;
+                }
             }
         }
         match stack.pop() {
@@ -294,6 +301,13 @@ impl<const SLACK: bool> Any<SLACK> {
             None => Step::Done,
         }
     }
+}
+
+/// The packets of the leaf `r` names: one, or two side by side.
+#[inline(always)]
+fn leaf_packets(r: u32) -> std::ops::RangeInclusive<usize> {
+    let first = (r & INDEX) as usize;
+    first..=first + usize::from(r & PAIR != 0)
 }
 
 /// The full record of a hit on lane `lane` of packet `p`.
@@ -319,7 +333,7 @@ fn touch(nodes: &[Node], packets: &[Packet], r: u32) -> u32 {
             b[0][0].x.to_bits() ^ b[2][0].y.to_bits() ^ b[4][0].z.to_bits() ^ n.child[0]
         })
     } else {
-        packets.get((r & !LEAF) as usize).map_or(0, |p| {
+        packets.get((r & INDEX) as usize).map_or(0, |p| {
             p.v0[0].x.to_bits() ^ p.e1[1].y.to_bits() ^ p.e2[2].z.to_bits()
         })
     }
