@@ -238,9 +238,12 @@ impl<'a> Collapse<'a> {
     fn reference(&self, b2: u32, out: &mut Arrays, work: &mut Vec<(u32, u32)>) -> u32 {
         if self.choice[b2 as usize][0] == 0 {
             let first = out.packets.len() as u32;
-            let packets = self.packets(b2);
-            let pair = if packets.len() == 2 { PAIR } else { 0 };
-            out.packets.extend(packets);
+            self.packets(b2, &mut out.packets);
+            let pair = if out.packets.len() as u32 - first == 2 {
+                PAIR
+            } else {
+                0
+            };
             LEAF | pair | first
         } else {
             let wide = out.nodes.len() as u32;
@@ -260,9 +263,9 @@ impl<'a> Collapse<'a> {
         kids
     }
 
-    /// The packets of the (at most eight) triangles under binary node `b2`: the first four in
-    /// tree order, then the rest.
-    fn packets(&self, b2: u32) -> Vec<Packet> {
+    /// Appends to `out` the packets of the (at most eight) triangles under binary node `b2`:
+    /// the first four in tree order, then the rest.
+    fn packets(&self, b2: u32, out: &mut Vec<Packet>) {
         const EMPTY_PACKET: Packet = Packet {
             v0: [Vec4::ZERO; 3],
             e1: [Vec4::ZERO; 3],
@@ -270,7 +273,6 @@ impl<'a> Collapse<'a> {
             ids: [[EMPTY; WIDTH]; 2],
             _pad: [0; 4],
         };
-        let mut packets = Vec::with_capacity(2);
         let mut packet = EMPTY_PACKET;
         let mut lane = 0;
         let mut pending = vec![b2];
@@ -284,7 +286,7 @@ impl<'a> Collapse<'a> {
             let first = node.first_index as usize;
             for &prim in &self.bvh2.primitive_indices[first..first + node.prim_count as usize] {
                 if lane == WIDTH {
-                    packets.push(packet);
+                    out.push(packet);
                     packet = EMPTY_PACKET;
                     lane = 0;
                 }
@@ -300,7 +302,6 @@ impl<'a> Collapse<'a> {
                 lane += 1;
             }
         }
-        packets.push(packet);
-        packets
+        out.push(packet);
     }
 }
