@@ -163,6 +163,23 @@ pub trait Camera: Send + Sync {
     }
 }
 
+/// Checks a `focal_plane_tilt` (degrees about camera x and y): each angle finite and in
+/// (-90, 90).
+pub(crate) fn validate_tilt(tilt: [f32; 2]) -> Result<(), CameraError> {
+    if tilt.iter().all(|a| a.is_finite() && a.abs() < 90.0) {
+        Ok(())
+    } else {
+        Err(CameraError::FocalPlaneTilt { got: tilt })
+    }
+}
+
+/// The slopes `(tan(b), tan(a))` of the plane of focus tilted by `[a, b]` degrees: its z
+/// grows by these per unit of x and y.
+pub(crate) fn tilt_slopes(tilt: [f32; 2]) -> glam::DVec2 {
+    let [a, b] = tilt.map(|d| f64::from(d).to_radians().tan());
+    glam::DVec2::new(b, a)
+}
+
 /// A thin lens: the aperture radius, the distance of the plane in focus, the aperture's
 /// shape, and (perspective only) the tilt of the plane of focus.
 ///
@@ -248,10 +265,7 @@ impl ThinLens {
             });
         }
         self.aperture.validate()?;
-        let tilt = self.focal_plane_tilt;
-        if !tilt.iter().all(|a| a.is_finite() && a.abs() < 90.0) {
-            return Err(CameraError::FocalPlaneTilt { got: tilt });
-        }
+        validate_tilt(self.focal_plane_tilt)?;
         if self.is_tilted() && !self.is_thin_lens() {
             return Err(CameraError::TiltWithoutLens);
         }
@@ -273,10 +287,7 @@ impl ThinLens {
     /// The tilted plane's slopes `(tan(b), tan(a))`: camera z on the plane of focus grows by
     /// these per unit of camera x and y.
     pub fn tilt_slopes(&self) -> glam::Vec2 {
-        let [a, b] = self
-            .focal_plane_tilt
-            .map(|d| f64::from(d).to_radians().tan() as f32);
-        glam::Vec2::new(b, a)
+        tilt_slopes(self.focal_plane_tilt).as_vec2()
     }
 
     /// The camera-space z at which the ray through the lens centre with camera-space

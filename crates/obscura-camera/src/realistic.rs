@@ -395,9 +395,7 @@ impl RealisticCamera {
         }
         lens.aperture.validate()?;
         let tilt = lens.focal_plane_tilt;
-        if !tilt.iter().all(|a| a.is_finite() && a.abs() < 90.0) {
-            return Err(CameraError::FocalPlaneTilt { got: tilt });
-        }
+        crate::camera::validate_tilt(tilt)?;
         let focus_mm = f64::from(lens.focus_distance) * MM_PER_UNIT;
         if lens.focus_distance <= 0.0 {
             return Err(CameraError::FocusDistance {
@@ -491,9 +489,8 @@ impl RealisticCamera {
         }
 
         if tilt != [0.0, 0.0] {
-            let [a, b] = tilt.map(|d| f64::from(d).to_radians().tan());
             camera.tilt = camera
-                .film_slopes(focus_mm, DVec2::new(b, a))
+                .film_slopes(focus_mm, crate::camera::tilt_slopes(tilt))
                 .ok_or(CameraError::TiltOutOfReach { got: tilt })?;
             // The film's corners may come at most halfway to the rear vertex (a film tilted
             // by up to 45 degrees behind the double Gauss): nearer, its rays would start
