@@ -6,7 +6,7 @@ use crate::aperture::Aperture;
 use crate::camera::{Camera, CameraBase, CameraRay, CameraRayDifferential, CameraSample};
 use crate::chain::{self, CameraRayParts, PoseCache};
 use crate::error::{CameraError, finite};
-use glam::{DVec2, DVec3};
+use glam::{DMat3, DQuat, DVec2, DVec3};
 use obscura_space::{Point2, Point3, Raster, World};
 
 /// Millimetres per world unit: lens prescriptions are in millimetres and the realistic camera
@@ -317,7 +317,8 @@ impl PupilBound {
 ///   vertex plane that holds every rear point through which a ray from the segment's film
 ///   points gets through, grown by one grid cell; a film point off the axis rotates its
 ///   segment's rectangle to its azimuth.
-/// - Weight: `cos^4(theta) A / (Delta^2 E_0)` with `theta` the ray's angle to the axis, `A` the
+/// - Weight: `cos^4(theta) A / (Delta^2 E_0)` (on a tilted film `cos(theta_f) cos^3(theta)`,
+///   `theta_f` the ray's angle to the film's normal) with `theta` the ray's angle to the axis, `A` the
 ///   bound's area (the inverse of the sample's density), `Delta` the film point's distance
 ///   from the rear vertex's plane (`delta` at the film centre), and `E_0` the film centre's
 ///   irradiance from a uniform unit sky, the same integral over the rear plane estimated at
@@ -327,8 +328,9 @@ impl PupilBound {
 ///   imaged onto a tilted film `z = s_x x + s_y y` (Scheimpflug). Each slope is measured by
 ///   tracing: the best-focus images (least RMS spread of a traced bundle) of two points of
 ///   the plane on either side of the axis, the slope of the line through them. Paraxially
-///   `s = m tan`, `m` the lateral magnification. Film positions keep their `(x, y)`, so the
-///   raster maps to the film's projection on the plane z = 0. The exit-pupil bounds hold film
+///   `s = m tan`, `m` the lateral magnification. The film is rigid, as a view camera's tilted
+///   back is: the flat film turned about the axis through its centre that takes its normal to
+///   the tilted plane's, so pixels keep their spacing along it. The exit-pupil bounds hold film
 ///   points at the ends of the depths a segment's radius reaches.
 ///
 /// `project` finds the chief ray through the stop's centre (secant on the stop height, from
@@ -351,6 +353,9 @@ pub struct RealisticCamera {
     /// The film's slopes: film point `(x, y)` lies at `z = tilt.x x + tilt.y y` (zero when
     /// the plane of focus is not tilted).
     tilt: DVec2,
+    /// The tilted film's frame: the turn taking a flat film point `(x, y, 0)` to its place on
+    /// the tilted film (the identity when untilted).
+    film_frame: DMat3,
     bounds: Vec<PupilBound>,
     /// `delta^2 / (delta^2 E_0) = 1 / E_0` with `E_0` as `centre_irradiance` gives it (the
     /// integral of `cos^4`, without the `1 / delta^2` both share): the weight's constant.
@@ -444,6 +449,7 @@ impl RealisticCamera {
             film_radius: 0.5 * diagonal,
             film_distance: 0.0,
             tilt: DVec2::ZERO,
+            film_frame: DMat3::IDENTITY,
             bounds: Vec::new(),
             weight_scale: 0.0,
             focal_length: 0.0,
@@ -498,6 +504,8 @@ impl RealisticCamera {
             if camera.film_radius * camera.tilt.length() > 0.5 * camera.film_distance {
                 return Err(CameraError::TiltOutOfReach { got: tilt });
             }
+            let normal = (-camera.tilt).extend(1.0).normalize();
+            camera.film_frame = DMat3::from_quat(DQuat::from_rotation_arc(DVec3::Z, normal));
         }
 
         // Exit-pupil bounds, then the weights' normaliser at the film centre.
@@ -934,19 +942,30 @@ impl RealisticCamera {
         sum * size.element_product()
     }
 
-    /// The film point (mm) of a raster position: the lens inverts the image.
+    /// The film point (mm) of a raster position: the lens inverts the image. On a tilted
+    /// film, the `(x, y)` of the raster position's place on the rigid film.
     fn film_point(&self, p: Point2<Raster>) -> DVec2 {
         let [w, h] = self.base.film.resolution().map(f64::from);
         let u = (f64::from(p.x) / w - 0.5) * self.film_size.x;
         let v = (0.5 - f64::from(p.y) / h) * self.film_size.y;
-        DVec2::new(-u, -v)
+        let flat = DVec2::new(-u, -v);
+        if self.tilt == DVec2::ZERO {
+            flat
+        } else {
+            (self.film_frame * flat.extend(0.0)).truncate()
+        }
     }
 
     /// The raster position of a film point (mm).
     fn raster_point(&self, film: DVec2) -> Point2<Raster> {
+        let flat = if self.tilt == DVec2::ZERO {
+            film
+        } else {
+            (self.film_frame.transpose() * self.film_at(film)).truncate()
+        };
         let [w, h] = self.base.film.resolution().map(f64::from);
-        let x = (-film.x / self.film_size.x + 0.5) * w;
-        let y = (0.5 + film.y / self.film_size.y) * h;
+        let x = (-flat.x / self.film_size.x + 0.5) * w;
+        let y = (0.5 + flat.y / self.film_size.y) * h;
         Point2::new(x as f32, y as f32)
     }
 
@@ -962,12 +981,24 @@ impl RealisticCamera {
         let azimuth = if r > 0.0 { film / r } else { DVec2::X };
         let rear = azimuth.rotate(q);
         // Trace; weight cos^4(theta) A T / (Delta^2 E_0), T the light the stop passes and
-        // Delta the film point's distance from the rear plane (delta, but on a tilted film).
+        // Delta the film point's distance from the rear plane (delta, but on a tilted film,
+        // where one cosine is to the film's normal).
         let o = self.film_at(film);
         let ray = self.film_ray(o, rear);
         let (out, passed) = self.trace_from_film(ray, Clip::Stop)?;
         let near = self.film_distance / (self.film_distance - o.z);
-        let weight = ray.d.z.powi(4) * bound.area() * passed * self.weight_scale * near * near;
+        // cos at the film times cos^3 at the rear plane: on a tilted film the first is to the
+        // film's own normal.
+        let cosines = if self.tilt == DVec2::ZERO {
+            ray.d.z.powi(4)
+        } else {
+            let facing = self.film_frame.z_axis.dot(ray.d);
+            if facing <= 0.0 {
+                return None;
+            }
+            facing * ray.d.z.powi(3)
+        };
+        let weight = cosines * bound.area() * passed * self.weight_scale * near * near;
         Some((out, weight))
     }
 

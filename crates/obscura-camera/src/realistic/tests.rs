@@ -408,22 +408,33 @@ fn every_ray_that_gets_through_starts_inside_the_pupil_bound() {
 }
 
 /// The film irradiance of a uniform unit sky at film point `film`, up to a constant, by
-/// sampling the rear element's whole plane (not the pupil bounds): the mean of
-/// `cos^4(theta) / Delta^2` over rays that get through (`Delta` the film point's distance from
-/// the rear plane, in units of the film centre's), times the sampled area, and the standard
+/// sampling the rear element's whole plane (not the pupil bounds): the radiometric
+/// `E = int cos(theta_film) cos(theta_rear) / r^2 dA` over rays that get through, with
+/// `theta_film` the ray's angle to the film's unit `normal`, `theta_rear` its angle to the axis
+/// (the rear plane's normal) and `r` the distance from the film point to the rear-plane point;
+/// times `delta^2`, the film centre's distance from the rear plane squared, which makes it
+/// `cos^4(theta)` on a flat film. Returns the mean times the sampled area, and the standard
 /// error.
-fn irradiance_brute(camera: &RealisticCamera, film: DVec2, n: usize, seed: u64) -> (f64, f64) {
+fn irradiance_brute(
+    camera: &RealisticCamera,
+    film: DVec2,
+    normal: DVec3,
+    n: usize,
+    seed: u64,
+) -> (f64, f64) {
     let rear = 1.5 * camera.elements.last().unwrap().aperture_radius;
     let area = 4.0 * rear * rear;
+    let delta = camera.film_distance;
     let mut u = Uniforms(seed);
     let (mut sum, mut sum2) = (0.0, 0.0);
     for _ in 0..n {
         let q = DVec2::new(2.0 * u.next() - 1.0, 2.0 * u.next() - 1.0) * rear;
         let o = camera.film_at(film);
         let ray = camera.film_ray(o, q);
-        let delta = (camera.film_distance - o.z) / camera.film_distance;
+        let to = q.extend(delta) - o;
         let f = if camera.trace_from_film(ray, Clip::Stop).is_some() {
-            area * ray.d.z.powi(4) / (delta * delta)
+            let (cos_film, cos_rear) = (normal.dot(to) / to.length(), to.z / to.length());
+            area * cos_film * cos_rear * delta * delta / to.length_squared()
         } else {
             0.0
         };
@@ -472,13 +483,15 @@ fn relative_illumination_matches_brute_force_and_is_one_at_the_centre() {
     let n = 40_000;
     for camera in [double_gauss(), &focused(WIDE, 3.0), steep()] {
         let [w, h] = camera.base.film.resolution().map(|v| v as f32);
-        let (e0, s0) = irradiance_brute(camera, DVec2::ZERO, 4 * n, 11);
+        // The normaliser is the flat film's centre; a tilted film's own normal, from its slopes.
+        let (e0, s0) = irradiance_brute(camera, DVec2::ZERO, DVec3::Z, 4 * n, 11);
+        let normal = (-camera.tilt).extend(1.0).normalize();
         let mut previous = f64::INFINITY;
         for (i, t) in [0.0f32, 0.3, 0.6, 0.8, 0.95].into_iter().enumerate() {
             // Along the film's diagonal from the centre.
             let p = Point2::new(0.5 * w * (1.0 + t), 0.5 * h * (1.0 + t));
             let film = camera.film_point(p);
-            let (e, s) = irradiance_brute(camera, film, n, 100 + i as u64);
+            let (e, s) = irradiance_brute(camera, film, normal, n, 100 + i as u64);
             let relative = e / e0;
             let relative_se = relative * ((s / e).powi(2) + (s0 / e0).powi(2)).sqrt();
             let (mean, se) = irradiance_camera(camera, p, n, 200 + i as u64);
@@ -487,7 +500,7 @@ fn relative_illumination_matches_brute_force_and_is_one_at_the_centre() {
                 (mean - relative).abs() < bound,
                 "t {t}: camera {mean} +- {se}, brute force {relative} +- {relative_se}"
             );
-            if t == 0.0 {
+            if t == 0.0 && camera.tilt == DVec2::ZERO {
                 assert!((mean - 1.0).abs() < 5.0 * se.max(1e-3), "centre {mean}");
             }
             // Falls off towards the corner (cos^4 and vignetting).
@@ -738,6 +751,34 @@ fn steep() -> &'static RealisticCamera {
             },
         )
     })
+}
+
+#[test]
+fn a_tilted_film_is_rigid() {
+    // A view camera's tilted back keeps its pixels' spacing: the raster's corners, placed on
+    // the tilted film, are a film width, a film height and a diagonal apart, as on the flat
+    // film; every placed point lies in the film's plane through the centre; and a raster
+    // point comes back from its film point.
+    let camera = steep();
+    assert!(camera.tilt.length() > 0.3, "{}", camera.tilt);
+    let [w, h] = camera.base.film.resolution().map(|v| v as f32);
+    let at = |x: f32, y: f32| camera.film_at(camera.film_point(Point2::new(x, y)));
+    let (a, b, c) = (at(0.0, 0.0), at(w, 0.0), at(0.0, h));
+    let size = camera.film_size;
+    let close = |got: f64, want: f64| (got - want).abs() < 1e-9 * want;
+    assert!(close((b - a).length(), size.x), "{} against {}", (b - a).length(), size.x);
+    assert!(close((c - a).length(), size.y), "{} against {}", (c - a).length(), size.y);
+    assert!(close((c - b).length(), size.length()));
+    assert!(at(0.5 * w, 0.5 * h).length() < 1e-12);
+    let normal = (-camera.tilt).extend(1.0).normalize();
+    let mut u = Uniforms(5);
+    for _ in 0..200 {
+        let p = Point2::new((u.next() * f64::from(w)) as f32, (u.next() * f64::from(h)) as f32);
+        let film = at(p.x, p.y);
+        assert!(normal.dot(film).abs() < 1e-12, "{film}");
+        let back = camera.raster_point(camera.film_point(p));
+        assert!((back.x - p.x).abs() < 1e-4 && (back.y - p.y).abs() < 1e-4, "{p:?} {back:?}");
+    }
 }
 
 #[test]
