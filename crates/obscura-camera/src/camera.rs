@@ -181,7 +181,7 @@ pub(crate) fn tilt_slopes(tilt: [f32; 2]) -> glam::DVec2 {
 }
 
 /// A thin lens: the aperture radius, the distance of the plane in focus, the aperture's
-/// shape, and (perspective only) the tilt of the plane of focus.
+/// shape, and (perspective and orthographic) the tilt of the plane of focus.
 ///
 /// With a tilt `[a, b]` (degrees about camera x, then y) the plane of focus is
 /// `z = focal_distance + y tan(a) + x tan(b)` in camera space (Scheimpflug): the plane

@@ -114,11 +114,11 @@ pub enum CameraError {
     },
     /// A focal-plane tilt on a camera that cannot tilt it.
     #[error(
-        "focal_plane_tilt needs a perspective camera with a thin lens (lens_radius > 0) or a realistic camera: a pinhole or another model has no plane of focus to tilt"
+        "focal_plane_tilt needs a perspective or orthographic camera with a thin lens (lens_radius > 0) or a realistic camera: a pinhole or another model has no plane of focus to tilt"
     )]
     TiltWithoutLens,
     /// An exposure setting out of range.
-    #[error("{what} must be {need}, got {got}")]
+    #[error("{what} must be {need}, got {got:?}")]
     Exposure {
         /// The key, e.g. `"f_number"`.
         what: &'static str,

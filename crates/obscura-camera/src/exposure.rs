@@ -63,12 +63,50 @@ impl Exposure {
                 });
             }
         }
-        let scale = self.scale();
-        if !(self.compensation.is_finite() && scale.is_finite() && scale > 0.0) {
+        if !self.compensation.is_finite() {
             return Err(CameraError::Exposure {
                 what: "exposure_compensation",
-                need: "a finite number of stops giving a finite, non-zero exposure",
+                need: "a finite number of stops",
                 got: self.compensation,
+            });
+        }
+        let scale = self.scale();
+        if !(scale.is_finite() && scale > 0.0) {
+            // Each setting's share of the scale, in stops; the one that pushes furthest the
+            // way the scale ran out of range (too large or too small) is named.
+            let shares = [
+                (
+                    "f_number",
+                    self.f_number,
+                    -2.0 * f64::from(self.f_number).log2(),
+                ),
+                (
+                    "shutter_time",
+                    self.shutter_time,
+                    f64::from(self.shutter_time).log2(),
+                ),
+                (
+                    "iso",
+                    self.iso,
+                    (f64::from(self.iso) / f64::from(ISO_CALIBRATION)).log2(),
+                ),
+                (
+                    "exposure_compensation",
+                    self.compensation,
+                    f64::from(self.compensation),
+                ),
+            ];
+            let sign = if scale > 0.0 { 1.0 } else { -1.0 };
+            let (what, got, _) =
+                shares.into_iter().fold(
+                    shares[0],
+                    |a, b| if b.2 * sign > a.2 * sign { b } else { a },
+                );
+            return Err(CameraError::Exposure {
+                what,
+                need: "a value that, with the other exposure settings, gives a finite, \
+                       non-zero exposure scale t S 2^EV / (100 N^2)",
+                got,
             });
         }
         Ok(())
@@ -146,5 +184,38 @@ mod tests {
             assert!(bad.validate().is_err(), "{bad:?}");
         }
         assert!(Exposure::UNIT.validate().is_ok());
+    }
+
+    #[test]
+    fn an_exposure_out_of_range_names_the_setting_that_took_it_there() {
+        let named = |e: Exposure| match e.validate() {
+            Err(CameraError::Exposure { what, got, .. }) => (what, got),
+            other => panic!("{e:?}: {other:?}"),
+        };
+        // f/1e-30 alone makes 1e60: too large for f32, and f_number pushed it there.
+        let tiny_n = Exposure {
+            f_number: 1e-30,
+            ..Exposure::UNIT
+        };
+        assert_eq!(named(tiny_n), ("f_number", 1e-30));
+        // 1e38 s is 2^126 and ISO 1e38 is 2^120 over ISO 100: the shutter time is named.
+        let long = Exposure {
+            shutter_time: 1e38,
+            iso: 1e38,
+            ..Exposure::UNIT
+        };
+        assert_eq!(named(long), ("shutter_time", 1e38));
+        // Too small: 1e-30 s (2^-100) at f/1e10 (2^-66) is 1e-50.
+        let dark = Exposure {
+            f_number: 1e10,
+            shutter_time: 1e-30,
+            ..Exposure::UNIT
+        };
+        assert_eq!(named(dark), ("shutter_time", 1e-30));
+        let minus = Exposure {
+            compensation: -1000.0,
+            ..Exposure::UNIT
+        };
+        assert_eq!(named(minus), ("exposure_compensation", -1000.0));
     }
 }

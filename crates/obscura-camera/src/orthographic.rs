@@ -24,7 +24,10 @@ use obscura_space::{Point2, Point3, Raster, Ray, Vector3, World};
 /// ```
 ///
 /// With a thin lens the lens point is offset from the film point's own ray origin (not from
-/// the camera centre), and every lens sample meets that ray at camera z = focal distance.
+/// the camera centre), and every lens sample meets that ray at camera z = focal distance, or,
+/// with the plane of focus tilted by `[a, b]` ([`ThinLens::focal_plane_tilt`]), where the ray
+/// meets the plane `z = focal_distance + y tan(a) + x tan(b)`: at the film point `(x, y)`'s own
+/// depth `focal_distance + x tan(b) + y tan(a)`.
 #[derive(Debug, Clone)]
 pub struct OrthographicCamera {
     projective: ProjectiveCamera,
@@ -33,6 +36,8 @@ pub struct OrthographicCamera {
     film_from_raster: (Vec3A, Vec3A),
     /// The pose cache of a fixed pose, computed once; None when the pose moves.
     fixed: Option<OrthographicCache>,
+    /// The tilted plane of focus's slopes ([`ThinLens::tilt_slopes`]); None untilted.
+    tilt: Option<Vec2>,
 }
 
 /// The per-pose cache of [`OrthographicCamera::ray`]. The film point `(x', y')` (camera
@@ -62,12 +67,8 @@ struct OrthographicCache {
 
 impl OrthographicCamera {
     /// An orthographic camera. Errors: non-finite numbers, `near < 0`, `near >= far`, a bad
-    /// shutter or lens (see [`ThinLens::validate`]).
+    /// shutter or lens (see [`ThinLens::validate`]; a tilt needs a thin lens).
     pub fn new(base: CameraBase, lens: ThinLens) -> Result<OrthographicCamera, CameraError> {
-        // Only the perspective thin lens tilts its plane of focus.
-        if lens.is_tilted() {
-            return Err(CameraError::TiltWithoutLens);
-        }
         base.validate(false)?;
         let (n, f) = (f64::from(base.near), f64::from(base.far));
         let screen_from_camera = from_rows([
@@ -82,6 +83,7 @@ impl OrthographicCamera {
             [0.0, 0.0, f - n, n],
             [0.0, 0.0, 0.0, 1.0],
         ]);
+        let tilt = lens.is_tilted().then(|| lens.tilt_slopes());
         let projective =
             ProjectiveCamera::build(base, lens, (screen_from_camera, camera_from_screen), false)?;
         let fixed = projective
@@ -92,6 +94,7 @@ impl OrthographicCamera {
             film_from_raster: projective.film_map(1.0),
             projective,
             fixed,
+            tilt,
         })
     }
 
@@ -156,15 +159,28 @@ impl OrthographicCamera {
             };
         }
         // Lens: from the lens point p_center + R (a.x, a.y, 0) to the focus point
-        // p_center + focal_distance R z, along R (-a.x, -a.y, focal_distance).
+        // p_center + z R z, along R (-a.x, -a.y, z), with z the focal distance or the film
+        // point's depth on the tilted plane.
         let base = self.projective.base();
         let a = lens.aperture_point(u_lens);
         let offset = cache.lens_x * a.x + cache.lens_y * a.y;
-        let v = cache.axis * lens.focal_distance - offset;
-        // Clip: that direction has camera z focal_distance, so camera z = near is at distance
-        // near * len / focal_distance along the unit direction.
+        let focus = match self.tilt {
+            None => Some(lens.focal_distance),
+            Some(slopes) => {
+                let z = lens.focal_distance + q.x * slopes.x + q.y * slopes.y;
+                (z > 0.0 && z.is_finite()).then_some(z)
+            }
+        };
+        let (v, focus) = match focus {
+            Some(z) => (cache.axis * z - offset, z),
+            // The tilted plane is behind the film point: in focus at infinity, every lens
+            // point's ray along R z.
+            None => (cache.axis, 1.0),
+        };
+        // Clip: that direction has camera z `focus`, so camera z = near is at distance
+        // near * len / focus along the unit direction.
         let length = v.length();
-        let per_z = length / lens.focal_distance;
+        let per_z = length / focus;
         // world_from_camera(t) of the origin: the lens point.
         Ray {
             origin: Point3::from_glam(Vec3::from(p_center + offset)),

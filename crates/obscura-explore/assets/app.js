@@ -43,7 +43,7 @@ const CONTROLS = [
   { key: 'distortion', kind: 'list', models: OPENCV },
   { key: 'aperture_image', kind: 'text', optional: true, models: [...PROJECTIVE, 'realistic'] },
   { key: 'anamorphic', kind: 'number', def: 1, models: [...PROJECTIVE, 'realistic'] },
-  { key: 'focal_plane_tilt', kind: 'vec', n: 2, def: [0, 0], models: ['perspective', 'realistic'] },
+  { key: 'focal_plane_tilt', kind: 'vec', n: 2, def: [0, 0], models: ['perspective', 'orthographic', 'realistic'] },
   { key: 'focal_length', kind: 'number', optional: true, models: PROJECTIVE },
   { key: 'shutter_curve', kind: 'json', optional: true, placeholder: '[[0, 0], [0.5, 1], [1, 0]]' },
   { key: 'rolling_shutter', kind: 'json', optional: true,

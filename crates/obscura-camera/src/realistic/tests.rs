@@ -766,18 +766,34 @@ fn a_tilted_film_is_rigid() {
     let (a, b, c) = (at(0.0, 0.0), at(w, 0.0), at(0.0, h));
     let size = camera.film_size;
     let close = |got: f64, want: f64| (got - want).abs() < 1e-9 * want;
-    assert!(close((b - a).length(), size.x), "{} against {}", (b - a).length(), size.x);
-    assert!(close((c - a).length(), size.y), "{} against {}", (c - a).length(), size.y);
+    assert!(
+        close((b - a).length(), size.x),
+        "{} against {}",
+        (b - a).length(),
+        size.x
+    );
+    assert!(
+        close((c - a).length(), size.y),
+        "{} against {}",
+        (c - a).length(),
+        size.y
+    );
     assert!(close((c - b).length(), size.length()));
     assert!(at(0.5 * w, 0.5 * h).length() < 1e-12);
     let normal = (-camera.tilt).extend(1.0).normalize();
     let mut u = Uniforms(5);
     for _ in 0..200 {
-        let p = Point2::new((u.next() * f64::from(w)) as f32, (u.next() * f64::from(h)) as f32);
+        let p = Point2::new(
+            (u.next() * f64::from(w)) as f32,
+            (u.next() * f64::from(h)) as f32,
+        );
         let film = at(p.x, p.y);
         assert!(normal.dot(film).abs() < 1e-12, "{film}");
         let back = camera.raster_point(camera.film_point(p));
-        assert!((back.x - p.x).abs() < 1e-4 && (back.y - p.y).abs() < 1e-4, "{p:?} {back:?}");
+        assert!(
+            (back.x - p.x).abs() < 1e-4 && (back.y - p.y).abs() < 1e-4,
+            "{p:?} {back:?}"
+        );
     }
 }
 

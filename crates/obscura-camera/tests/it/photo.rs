@@ -5,8 +5,8 @@
 use crate::{base_at, cases, identity_look};
 use glam::{Vec2, Vec3};
 use obscura_camera::{
-    Aperture, ApertureImage, Camera, CameraSample, FovAxis, PerspectiveCamera, RollingDirection,
-    RollingShutter, ShutterTiming, ThinLens,
+    Aperture, ApertureImage, Camera, CameraSample, FovAxis, OrthographicCamera, PerspectiveCamera,
+    RollingDirection, RollingShutter, ShutterTiming, ThinLens,
 };
 use obscura_sample::PiecewiseShutterCurve;
 use obscura_space::{Point2, Raster};
@@ -342,6 +342,51 @@ proptest! {
             let on_centre = d * (z / d.z);
             let predicted = o.length() * (1.0 - z / focus.z).abs();
             let spread = (on_ray - on_centre).length();
+            prop_assert!(
+                (spread - predicted).abs() < 1e-3 * (1.0 + predicted),
+                "spread {} predicted {}", spread, predicted
+            );
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(cases(64))]
+
+    /// The orthographic thin lens tilts its plane of focus too. A film point's centre ray runs
+    /// along +z from the film point `(x, y, 0)`, so it meets the plane
+    /// `z = 5 + y tan(a) + x tan(b)` at `(x, y, 5 + y tan(a) + x tan(b))`: every lens sample's
+    /// ray from that film point passes there, and off the plane spreads by `|a| |1 - z / z_f|`.
+    #[test]
+    fn an_orthographic_thin_lens_tilts_its_plane_of_focus(
+        tilt_x in -40f32..40.0, tilt_y in -40f32..40.0,
+        fx in 0.5f32..63.5, fy in 0.5f32..47.5,
+        depth_factor in 0.3f32..3.0,
+    ) {
+        let lens = ThinLens::new(0.2, 5.0).unwrap().with_tilt([tilt_x, tilt_y]).unwrap();
+        let base = base_at(identity_look(), [64, 48], None, 0.001, 1e30);
+        let cam = OrthographicCamera::new(base, lens).unwrap();
+        let p_film = Point2::<Raster>::new(fx, fy);
+        let centre = cam.generate_ray(&CameraSample::at(p_film)).unwrap().ray;
+        let film = to_camera(centre.origin);
+        prop_assert!(film.z.abs() < 1e-6 && to_camera_dir(centre.direction).z > 0.999_999);
+        let (ta, tb) = (tilt_x.to_radians().tan(), tilt_y.to_radians().tan());
+        let focus = Vec3::new(film.x, film.y, 5.0 + film.y * ta + film.x * tb);
+        prop_assume!(focus.z > 0.05);
+        for i in 0..16 {
+            let u = Vec2::new((i % 4) as f32 / 4.0 + 0.1, (i / 4) as f32 / 4.0 + 0.1);
+            let ray = cam
+                .generate_ray(&CameraSample { p_lens: u, ..CameraSample::at(p_film) })
+                .unwrap()
+                .ray;
+            let o = to_camera(ray.origin);
+            let dir = to_camera_dir(ray.direction);
+            let miss = (focus - o).cross(dir).length();
+            prop_assert!(miss < 1e-4 * focus.length().max(1.0), "miss {} at {}", miss, focus);
+            let z = depth_factor * focus.z;
+            let on_ray = o + dir * ((z - o.z) / dir.z);
+            let predicted = (o - film).length() * (1.0 - z / focus.z).abs();
+            let spread = (on_ray - Vec3::new(film.x, film.y, z)).length();
             prop_assert!(
                 (spread - predicted).abs() < 1e-3 * (1.0 + predicted),
                 "spread {} predicted {}", spread, predicted

@@ -115,7 +115,7 @@ fn reads(kind: CameraKind, key: &str) -> bool {
             matches!(kind, Perspective | Orthographic | Realistic)
         }
         "lens_file" | "aperture_diameter" | "focus_distance" | "film_diagonal" => kind == Realistic,
-        "focal_plane_tilt" => matches!(kind, Perspective | Realistic),
+        "focal_plane_tilt" => matches!(kind, Perspective | Orthographic | Realistic),
         "lens_shift" => matches!(kind, Perspective | Orthographic | Fisheye),
         "fx" | "fy" | "cx" | "cy" | "distortion" => matches!(kind, OpenCv | OpenCvFisheye),
         "projection" => kind == Fisheye,
@@ -328,7 +328,7 @@ impl Cx<'_> {
         let lens = match c.focal_plane_tilt {
             Some(tilt) => {
                 self.finite("camera.focal_plane_tilt", &tilt)?;
-                if kind == CameraKind::Perspective {
+                if matches!(kind, CameraKind::Perspective | CameraKind::Orthographic) {
                     lens.with_tilt(tilt).map_err(|e| self.camera_err(e))?
                 } else {
                     lens
