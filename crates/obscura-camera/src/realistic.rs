@@ -318,8 +318,8 @@ impl PupilBound {
 ///   points gets through, grown by one grid cell; a film point off the axis rotates its
 ///   segment's rectangle to its azimuth.
 /// - Weight: `cos^4(theta) A / (Delta^2 E_0)` (on a tilted film `cos(theta_f) cos^3(theta)`,
-///   `theta_f` the ray's angle to the film's normal) with `theta` the ray's angle to the axis, `A` the
-///   bound's area (the inverse of the sample's density), `Delta` the film point's distance
+///   `theta_f` the ray's angle to the film's normal) with `theta` the ray's angle to the axis,
+///   `A` the bound's area (the inverse of the sample's density), `Delta` the film point's distance
 ///   from the rear vertex's plane (`delta` at the film centre), and `E_0` the film centre's
 ///   irradiance from a uniform unit sky, the same integral over the rear plane estimated at
 ///   construction. So a uniform white sky gives 1 at the image centre and the lens's relative
