@@ -252,8 +252,10 @@ impl FilmGeometry {
         if !(in_unit(x0, x1) && in_unit(y0, y1)) {
             return Err(CameraError::CropWindow { got: crop_window });
         }
-        // pbrt's rule: pixel i is rendered when its index lies in [ceil(res * c0), ceil(res * c1)).
-        let edge = |res: u32, c: f32| ((f64::from(res) * f64::from(c)).ceil() as u32).min(res);
+        // pbrt's rule: pixel i is rendered when its index lies in [ceil(res * c0), ceil(res * c1)),
+        // the product taken in f32 as pbrt's Float (in f64, 0.1f32 * 60 is 6.00000009, whose
+        // ceiling is 7; the f32 product rounds to 6).
+        let edge = |res: u32, c: f32| ((res as f32 * c).ceil() as u32).min(res);
         let pixel_bounds = [
             edge(resolution[0], x0),
             edge(resolution[0], x1),
@@ -339,6 +341,11 @@ mod tests {
         assert_eq!(film.pixel_bounds(), [3, 8, 1, 3]);
         let full = FilmGeometry::new([10, 4], None, None).unwrap();
         assert_eq!(full.pixel_bounds(), [0, 10, 0, 4]);
+        // pbrt multiplies in f32: 60 * 0.1f32 = 6.0000000894 rounds to 6.0 (f32 steps are
+        // 4.8e-7 there), ceil 6; 80 * 0.1f32 rounds to 8.0, ceil 8. In f64 both would round up
+        // one more row or column.
+        let tenth = FilmGeometry::new([80, 60], None, Some([0.1, 0.9, 0.1, 0.9])).unwrap();
+        assert_eq!(tenth.pixel_bounds(), [8, 72, 6, 54]);
     }
 
     #[test]
