@@ -253,20 +253,7 @@ fn run_render(args: RenderArgs) -> Result<ExitCode, RenderError> {
     if slice.is_none() {
         OutputFormat::from_path(&output)?;
     }
-    let folder = match output.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    if !folder.is_dir() {
-        return Err(setting(
-            "-o",
-            format!(
-                "{}: the folder {} does not exist",
-                output.display(),
-                folder.display()
-            ),
-        ));
-    }
+    folder_exists("-o", &output)?;
     let mut threads = args.threads;
     if threads == Some(0) {
         return Err(setting("--threads", "must be >= 1, got 0"));
@@ -289,20 +276,7 @@ fn run_render(args: RenderArgs) -> Result<ExitCode, RenderError> {
         ));
     }
     if let Some(path) = &args.checkpoint {
-        let folder = match path.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p,
-            _ => Path::new("."),
-        };
-        if !folder.is_dir() {
-            return Err(setting(
-                "--checkpoint",
-                format!(
-                    "{}: the folder {} does not exist",
-                    path.display(),
-                    folder.display()
-                ),
-            ));
-        }
+        folder_exists("--checkpoint", path)?;
     }
 
     let (mut description, imported) = load_scene(scene_path)?;
@@ -628,6 +602,27 @@ fn render_slice(
 
 /// `obscura merge`: checks that the parts are one render's slices, each once, and writes the
 /// image; or, with --list-missing, prints the slices still to render.
+/// An error naming `flag` when the folder `path` would be written into does not exist (checked
+/// before any work, so the message names the user's path, not a temporary file beside it).
+fn folder_exists(flag: &'static str, path: &Path) -> Result<(), RenderError> {
+    let folder = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    if folder.is_dir() {
+        Ok(())
+    } else {
+        Err(setting(
+            flag,
+            format!(
+                "{}: the folder {} does not exist",
+                path.display(),
+                folder.display()
+            ),
+        ))
+    }
+}
+
 fn run_merge(args: MergeArgs) -> Result<ExitCode, RenderError> {
     if args.slices == Some(0) {
         return Err(setting("--slices", "must be >= 1, got 0"));
@@ -661,6 +656,7 @@ fn run_merge(args: MergeArgs) -> Result<ExitCode, RenderError> {
         return Err(setting("-o", "merge needs -o OUT.exr or OUT.png"));
     };
     OutputFormat::from_path(&output)?;
+    folder_exists("-o", &output)?;
     if args.parts.is_empty() {
         return Err(setting("merge", "no parts given"));
     }

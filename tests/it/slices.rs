@@ -243,6 +243,14 @@ fn merge_refuses_bad_sets_and_writes_nothing() {
             .collect();
         assert!(strays.is_empty(), "{what}: a temporary file was left");
     }
+    // Into a folder that does not exist: the message names it, not a temporary file.
+    let nowhere = dir.join("no-such-folder").join("out.exr");
+    let (code, stderr) = merge(&[p0.clone(), p1.clone(), p2.clone()], &nowhere);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("no-such-folder does not exist") && !stderr.contains("partial"),
+        "{stderr}"
+    );
     // The good set merges.
     assert_eq!(merge(&[p2, p0, p1], &out).0, 0);
     assert_ne!(std::fs::read(&out).unwrap(), b"an older image");
