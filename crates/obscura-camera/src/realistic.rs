@@ -7,7 +7,7 @@ use crate::camera::{Camera, CameraBase, CameraRay, CameraRayDifferential, Camera
 use crate::chain::{self, CameraRayParts, PoseCache};
 use crate::error::{CameraError, finite};
 use glam::{DMat3, DQuat, DVec2, DVec3};
-use obscura_space::{Point2, Point3, Raster, World};
+use obscura_space::{Point2, Point3, Raster, Ray, World};
 
 /// Millimetres per world unit: lens prescriptions are in millimetres and the realistic camera
 /// reads one world unit as one metre (as pbrt-v4 does).
@@ -573,6 +573,18 @@ impl RealisticCamera {
     pub fn chief_ray(&self, p_film: Point2<Raster>) -> Option<(DVec3, DVec3)> {
         let ray = self.chief_ray_lens(self.film_point(p_film))?;
         Some((ray.o / MM_PER_UNIT, ray.d))
+    }
+
+    /// The world-space chief ray of `sample`'s film point at `sample`'s time: [`Self::chief_ray`]
+    /// carried through the pose as [`Camera::generate_ray`] carries a traced ray
+    /// (`sample.p_lens` is not used). It is the ray [`Camera::project`] inverts, so any point
+    /// along it projects back to the film point: the ray to use for one ray per film point.
+    pub fn generate_chief_ray(&self, sample: &CameraSample) -> Option<Ray<World>> {
+        let time = crate::camera::ray_time(&self.base, sample)?;
+        let out = self.chief_ray_lens(self.film_point(sample.p_film))?;
+        let parts = CameraRayParts::by_distance(out.o / MM_PER_UNIT, out.d, &self.base);
+        let world_from_camera = self.pose.world_from_camera(&self.base, time);
+        Some(chain::to_world(&world_from_camera, parts, time))
     }
 
     /// The axial position (mm from the film) of the rear element's vertex.

@@ -4,9 +4,10 @@
 //!   (`Camera.from_toml`) or from OpenCV calibration (`Camera.from_opencv`,
 //!   `Camera.from_opencv_fisheye`); `generate_rays`, `project` and `pixel_rays` take and give
 //!   numpy arrays and run over the batch in parallel (rayon) with the GIL released.
-//! - [`PyScene`] (`obscura.Scene`, made by `obscura.load_scene`) and `obscura.render`: the
-//!   renderer of `obscura render`, giving the same float32 RGBA image bit for bit; Ctrl-C
-//!   interrupts it (KeyboardInterrupt).
+//! - [`PyScene`] (`obscura.Scene`, made by `obscura.load_scene` from a TOML, pbrt-v4 or
+//!   Mitsuba 3 file) and `obscura.render`: the renderer of `obscura render`, giving the same
+//!   float32 RGBA image bit for bit; Ctrl-C interrupts it (KeyboardInterrupt). A scene is lent
+//!   to one render at a time, and nothing waits for it while holding the GIL.
 //!
 //! Conventions are the scene format's: raster positions in pixels with pixel `(i, j)` covering
 //! `[i, i+1) x [j, j+1)`, so pixel centres are at `+0.5`; camera +z is the view, world units as
@@ -14,6 +15,8 @@
 //! for a bad scene; `TypeError`/`ValueError` for arrays of the wrong dtype or shape), never a
 //! crash of the interpreter.
 #![deny(missing_docs)]
+
+mod camera_file;
 
 use numpy::{
     IntoPyArray, PyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2, PyReadonlyArrayDyn,
@@ -29,14 +32,14 @@ use obscura_render::{
     camera_of, compose_stereo, load_description, parse_description, read_exr,
 };
 use obscura_sample::{Sampler, SamplerKind};
-use obscura_space::{Point2, Point3};
-use pyo3::exceptions::{PyTypeError, PyValueError};
+use obscura_space::{Point2, Point3, Ray, World};
+use pyo3::exceptions::{PyTypeError, PyUserWarning, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
-use std::sync::{Mutex, mpsc};
+use std::sync::{Condvar, Mutex, mpsc};
 use std::time::Duration;
 
 /// Rays per rayon job: large enough that scheduling costs nothing next to the rays.
@@ -166,12 +169,13 @@ fn vector(obj: &Bound<'_, PyAny>, name: &str, n: Option<usize>) -> PyResult<Vec<
     Ok(values)
 }
 
-/// Writes the ray of every sample into `origins`, `directions` (3 values per ray) and `valid`,
-/// in parallel. Every element is written (NaN and `false` where no ray leaves), so reused `out=`
-/// arrays hold nothing of an earlier call. `sample(i)` returns `None` for a sample whose input
-/// is not finite; the smallest such index is returned and the caller raises for it.
+/// Writes the ray `ray_of` gives for every sample into `origins`, `directions` (3 values per
+/// ray) and `valid`, in parallel. Every element is written (NaN and `false` where no ray
+/// leaves), so reused `out=` arrays hold nothing of an earlier call. `sample(i)` returns `None`
+/// for a sample whose input is not finite; the smallest such index is returned and the caller
+/// raises for it.
 fn fill_rays(
-    camera: &AnyCamera,
+    ray_of: impl Fn(&CameraSample) -> Option<Ray<World>> + Sync,
     sample: impl Fn(usize) -> Option<CameraSample> + Sync,
     origins: &mut [f32],
     directions: &mut [f32],
@@ -189,7 +193,7 @@ fn fill_rays(
             let rows = o.chunks_exact_mut(3).zip(d.chunks_exact_mut(3)).zip(v);
             for (k, ((o, d), v)) in rows.enumerate() {
                 let ray = match sample(first + k) {
-                    Some(s) => camera.generate_ray(&s),
+                    Some(s) => ray_of(&s),
                     None => {
                         first_bad = first_bad.min(first + k);
                         None
@@ -197,7 +201,7 @@ fn fill_rays(
                 };
                 match ray {
                     Some(r) => {
-                        let (p, w) = (r.ray.origin, r.ray.direction);
+                        let (p, w) = (r.origin, r.direction);
                         o.copy_from_slice(&[p.x, p.y, p.z]);
                         d.copy_from_slice(&[w.x, w.y, w.z]);
                         *v = true;
@@ -305,14 +309,14 @@ fn ray_arrays<'py>(
     ))
 }
 
-/// Fills `arrays` with the rays of `sample` ([`fill_rays`]) with the GIL released, and returns
-/// them as the `(origins, directions, valid)` tuple, with the first sample index whose input
-/// was not finite.
+/// Fills `arrays` with the rays `ray_of` gives for the samples of `sample` ([`fill_rays`])
+/// with the GIL released, and returns them as the `(origins, directions, valid)` tuple, with
+/// the first sample index whose input was not finite.
 fn trace_into<'py>(
     py: Python<'py>,
-    camera: &AnyCamera,
     arrays: RayArrays<'py>,
     sample: impl Fn(usize) -> Option<CameraSample> + Sync + Send,
+    ray_of: impl Fn(&CameraSample) -> Option<Ray<World>> + Sync + Send,
 ) -> PyResult<(Bound<'py, PyTuple>, Option<usize>)> {
     let (o_arr, d_arr, v_arr) = arrays;
     let bad = {
@@ -326,7 +330,7 @@ fn trace_into<'py>(
             d_rw.as_slice_mut()?,
             v_rw.as_slice_mut()?,
         );
-        py.allow_threads(|| fill_rays(camera, sample, o, d, v))
+        py.allow_threads(|| fill_rays(ray_of, sample, o, d, v))
     };
     Ok(((o_arr, d_arr, v_arr).into_pyobject(py)?, bad))
 }
@@ -394,24 +398,50 @@ pub struct PyCamera {
 /// The scene format's default sampler (`[sampler] type` absent).
 const DEFAULT_SAMPLER: SamplerKind = SamplerKind::Sobol;
 
-/// Reads a scene description from a path or from TOML text: an `os.PathLike`, or a one-line
-/// `str` that names an existing file or has no `=` (so cannot be a scene), is read as a file;
-/// any other `str` is parsed as the text of a scene file (errors then name `<string>`).
-fn description_of(obj: &Bound<'_, PyAny>) -> PyResult<SceneDescription> {
-    if let Ok(text) = obj.extract::<String>() {
+/// The camera's part ([`camera_file`]) of a scene file given by path or as TOML text: an
+/// `os.PathLike`, or a one-line `str` that names an existing file or has no `=` (so cannot be a
+/// scene), is read as a file; any other `str` is parsed as the text of a scene file (errors
+/// then name `<string>`).
+fn camera_description(obj: &Bound<'_, PyAny>) -> PyResult<SceneDescription> {
+    let (path, text) = if let Ok(text) = obj.extract::<String>() {
         let as_path = Path::new(&text);
         if !text.contains('\n') && (as_path.is_file() || !text.contains('=')) {
-            return load_description(as_path).map_err(render_err);
+            (as_path.to_path_buf(), scene_file_text(as_path)?)
+        } else {
+            (PathBuf::from("<string>"), text)
         }
-        return parse_description(Path::new("<string>"), &text).map_err(render_err);
-    }
-    match obj.extract::<PathBuf>() {
-        Ok(path) => load_description(&path).map_err(render_err),
-        Err(_) => Err(PyTypeError::new_err(format!(
-            "expected TOML text, a path string or an os.PathLike, got {}",
-            obj.get_type().name()?
-        ))),
-    }
+    } else {
+        match obj.extract::<PathBuf>() {
+            Ok(path) => {
+                let text = scene_file_text(&path)?;
+                (path, text)
+            }
+            Err(_) => {
+                return Err(PyTypeError::new_err(format!(
+                    "expected TOML text, a path string or an os.PathLike, got {}",
+                    obj.get_type().name()?
+                )));
+            }
+        }
+    };
+    let camera_text = camera_file::camera_tables(&text);
+    parse_description(&path, camera_text.as_deref().unwrap_or(&text)).map_err(render_err)
+}
+
+/// The text of a scene file, refused as the renderer refuses it (unreadable, or not UTF-8).
+fn scene_file_text(path: &Path) -> PyResult<String> {
+    let bytes = std::fs::read(path).map_err(|source| {
+        render_err(RenderError::Io {
+            file: path.to_path_buf(),
+            action: "cannot read the scene file",
+            source,
+        })
+    })?;
+    // The renderer's reader names the line of the first byte that is not UTF-8.
+    String::from_utf8(bytes).map_err(|_| match load_description(path) {
+        Err(e) => render_err(e),
+        Ok(_) => PyValueError::new_err(format!("{}: the file is not UTF-8 text", path.display())),
+    })
 }
 
 /// The film of an OpenCV calibration: `size` is (width, height).
@@ -471,13 +501,14 @@ fn model_name(c: &AnyCamera) -> &'static str {
 impl PyCamera {
     /// Camera.from_toml(text_or_path)
     ///
-    /// The camera of a scene file: its [camera] and [film] tables (a scene needs both; the
-    /// other tables are checked as `obscura check` does, then ignored). `text_or_path` is the
-    /// TOML text, a path string or an os.PathLike. Every camera model of the scene format works.
-    /// Raises ValueError naming the file, key and line for a bad scene.
+    /// The camera of a scene file: its [camera] and [film] tables, checked as the renderer
+    /// checks them, and [sampler] type, the sampler pixel_rays draws from. Every other table
+    /// and key is ignored, even one the renderer would refuse. `text_or_path` is the TOML
+    /// text, a path string or an os.PathLike. Every camera model of the scene format works.
+    /// Raises ValueError naming the file, key and line for a bad camera or film.
     #[staticmethod]
     fn from_toml(text_or_path: &Bound<'_, PyAny>) -> PyResult<PyCamera> {
-        let d = description_of(text_or_path)?;
+        let d = camera_description(text_or_path)?;
         let camera = camera_of(&d).map_err(render_err)?;
         Ok(PyCamera {
             camera: Box::new(camera),
@@ -571,9 +602,12 @@ impl PyCamera {
     /// cam.generate_rays(raster_xy, lens_uv=None, time=None) -> (origins, directions, valid)
     ///
     /// The world-space rays through raster positions `raster_xy` (N, 2) (pixel centres at
-    /// +0.5). `lens_uv` (N, 2) are lens samples in [0, 1)^2, warped onto the aperture (default
-    /// the lens centre, 0.5); `time` is the shutter sample u in [0, 1), a number or (N,),
-    /// mapped onto the shutter interval (default 0: shutter open). Returns float32 origins
+    /// +0.5). `lens_uv` (N, 2) are lens samples in [0, 1)^2, warped onto the aperture; without
+    /// them each film point gets the ray that `project` inverts: through the lens centre (0.5,
+    /// 0.5) for a thin lens, and for a realistic camera (a lens system) the chief ray, from the
+    /// film point through the centre of the aperture stop and out of the front element. `time`
+    /// is the shutter sample u in [0, 1), a number or (N,), mapped onto the shutter interval
+    /// (default 0: shutter open). Returns float32 origins
     /// (N, 3), unit directions (N, 3) and a bool mask (N,): false where no ray leaves that film
     /// point (past a fisheye's image circle, say), with NaN origin and direction there.
     /// Runs in parallel with the GIL released.
@@ -604,7 +638,8 @@ impl PyCamera {
         };
         let lens = lens_view.as_ref().map(|l| l.as_slice()).transpose()?;
         let time = time.map(|t| per_ray(t, "time", n)).transpose()?;
-        let (rays, bad) = trace_into(py, &self.camera, ray_arrays(py, out, n)?, |i| {
+        let arrays = ray_arrays(py, out, n)?;
+        let sample = |i: usize| {
             let (x, y) = (film[2 * i], film[2 * i + 1]);
             if !(x.is_finite() && y.is_finite()) {
                 return None;
@@ -621,7 +656,18 @@ impl PyCamera {
                 s.time = t[i];
             }
             Some(s)
-        })?;
+        };
+        let (rays, bad) = match (&*self.camera, lens) {
+            // No lens samples: the one ray of each film point that `project` inverts. For a
+            // thin lens that is the lens centre's; a lens system's is the chief ray, through
+            // the stop's centre (which no lens sample picks out).
+            (AnyCamera::Realistic(c), None) => {
+                trace_into(py, arrays, sample, |s| c.generate_chief_ray(s))?
+            }
+            (camera, _) => trace_into(py, arrays, sample, |s| {
+                camera.generate_ray(s).map(|r| r.ray)
+            })?,
+        };
         if let Some(i) = bad {
             let film_ok = film[2 * i].is_finite() && film[2 * i + 1].is_finite();
             return Err(not_finite(if film_ok { "lens_uv" } else { "raster_xy" }, i));
@@ -720,7 +766,7 @@ impl PyCamera {
         let spp_us = spp as usize;
         let w_us = w as usize;
         let arrays = ray_arrays(py, out, n as usize)?;
-        let (rays, _) = trace_into(py, camera, arrays, |i| {
+        let sample = |i| {
             let s = (i % spp_us) as u32;
             let pixel = i / spp_us;
             let x = x0 + (pixel % w_us) as u32;
@@ -732,6 +778,9 @@ impl PyCamera {
                 uses_lens,
                 uses_time,
             ))
+        };
+        let (rays, _) = trace_into(py, arrays, sample, |s| {
+            camera.generate_ray(s).map(|r| r.ray)
         })?;
         Ok(rays)
     }
@@ -740,17 +789,96 @@ impl PyCamera {
 /// A scene loaded from a file and built (geometry, BVHs, materials, lights), ready to render.
 #[pyclass(name = "Scene", module = "obscura", frozen)]
 pub struct PyScene {
-    /// The built scene, boxed (its BVH wants more alignment than a Python object has);
-    /// `render` sets its sampler and integrator for each call.
-    scene: Mutex<Box<RenderScene>>,
-    /// The file's own sampler settings and integrator, restored when a call overrides none.
-    file_sampler: (SamplerKind, u32, u64),
-    file_integrator: IntegratorKind,
+    /// The built scene, lent to one render at a time.
+    slot: SceneSlot,
+    /// What the file says (before any call's overrides), and the camera it makes: read by the
+    /// getters and by `render` without waiting for a render that has the scene. Boxed, as the
+    /// camera in [`PyCamera`].
+    description: Box<SceneDescription>,
+    camera: Box<AnyCamera>,
     path: PathBuf,
 }
 
-fn lock(m: &Mutex<Box<RenderScene>>) -> std::sync::MutexGuard<'_, Box<RenderScene>> {
+/// A built scene that one render at a time takes out and puts back ([`SceneSlot::take`]).
+///
+/// The mutex is held only while the scene is taken or put back, never while its holder waits
+/// for anything. Holding a lock on the scene for a whole render deadlocked: the render's
+/// waiting thread needs the GIL to report progress and check Ctrl-C, while another Python
+/// thread held the GIL and waited for the lock (to read `scene.camera`, or to render).
+struct SceneSlot {
+    /// The scene, boxed (its BVH wants more alignment than a Python object has); None while
+    /// a render has it.
+    scene: Mutex<Option<Box<RenderScene>>>,
+    /// Signalled when a render puts the scene back.
+    returned: Condvar,
+}
+
+/// A scene taken from its [`SceneSlot`]; dropping it puts the scene back, even when the render
+/// panicked.
+struct Lease<'a> {
+    slot: &'a SceneSlot,
+    scene: Option<Box<RenderScene>>,
+}
+
+fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+impl SceneSlot {
+    fn new(scene: RenderScene) -> Self {
+        SceneSlot {
+            scene: Mutex::new(Some(Box::new(scene))),
+            returned: Condvar::new(),
+        }
+    }
+
+    /// Takes the scene, waiting while another render has it. Call it with the GIL released:
+    /// every [`POLL`] of waiting it calls `poll` (which may take the GIL to check Ctrl-C),
+    /// whose error ends the wait.
+    fn take(&self, poll: impl Fn() -> PyResult<()>) -> PyResult<Lease<'_>> {
+        let mut guard = lock(&self.scene);
+        loop {
+            if let Some(scene) = guard.take() {
+                return Ok(Lease {
+                    slot: self,
+                    scene: Some(scene),
+                });
+            }
+            guard = match self.returned.wait_timeout(guard, POLL) {
+                Ok((g, _)) => g,
+                Err(e) => e.into_inner().0,
+            };
+            if guard.is_none() {
+                drop(guard);
+                poll()?;
+                guard = lock(&self.scene);
+            }
+        }
+    }
+}
+
+impl std::ops::Deref for Lease<'_> {
+    type Target = RenderScene;
+    fn deref(&self) -> &RenderScene {
+        self.scene
+            .as_ref()
+            .expect("a lease holds its scene until dropped")
+    }
+}
+
+impl std::ops::DerefMut for Lease<'_> {
+    fn deref_mut(&mut self) -> &mut RenderScene {
+        self.scene
+            .as_mut()
+            .expect("a lease holds its scene until dropped")
+    }
+}
+
+impl Drop for Lease<'_> {
+    fn drop(&mut self) {
+        *lock(&self.slot.scene) = self.scene.take();
+        self.slot.returned.notify_one();
+    }
 }
 
 #[pymethods]
@@ -758,26 +886,26 @@ impl PyScene {
     /// (width, height) of the film in pixels.
     #[getter]
     fn resolution(&self) -> (u32, u32) {
-        let [w, h] = lock(&self.scene).description.film.resolution;
+        let [w, h] = self.description.film.resolution;
         (w, h)
     }
 
     /// Samples per pixel the file asks for.
     #[getter]
     fn spp(&self) -> u32 {
-        self.file_sampler.1
+        self.description.sampler.spp
     }
 
     /// The file's sampler seed.
     #[getter]
     fn seed(&self) -> u64 {
-        self.file_sampler.2
+        self.description.sampler.seed
     }
 
     /// The file's integrator: path, depth, distance, position, normal or albedo.
     #[getter]
     fn integrator(&self) -> &'static str {
-        self.file_integrator.name()
+        self.description.integrator.kind.name()
     }
 
     /// The scene file's path.
@@ -790,8 +918,8 @@ impl PyScene {
     #[getter]
     fn camera(&self) -> PyCamera {
         PyCamera {
-            camera: Box::new(lock(&self.scene).camera.clone()),
-            sampler: self.file_sampler.0,
+            camera: self.camera.clone(),
+            sampler: self.description.sampler.kind,
         }
     }
 
@@ -808,22 +936,42 @@ impl PyScene {
 
 /// load_scene(path) -> Scene
 ///
-/// Reads, validates and builds a scene file (meshes and maps load now, relative to the file).
+/// Reads, validates and builds a scene file (meshes and maps load now, relative to the file):
+/// the scene format's TOML, or a pbrt-v4 (.pbrt) or Mitsuba 3 (.xml) scene, imported as
+/// `obscura render` imports it (what the import approximates or leaves out is a UserWarning).
 /// Raises ValueError naming the file, key and line for a bad scene.
 #[pyfunction]
 fn load_scene(py: Python<'_>, path: PathBuf) -> PyResult<PyScene> {
-    let d = load_description(&path).map_err(render_err)?;
-    let file_sampler = (d.sampler.kind, d.sampler.spp, d.sampler.seed);
-    let file_integrator = d.integrator.kind;
-    let scene = py
-        .allow_threads(|| RenderScene::build(d))
-        .map_err(render_err)?;
+    let (scene, warnings) = py.allow_threads(|| build_scene(&path))?;
+    for w in warnings {
+        PyErr::warn(
+            py,
+            &py.get_type::<PyUserWarning>(),
+            &std::ffi::CString::new(w.replace('\0', " "))?,
+            1,
+        )?;
+    }
     Ok(PyScene {
-        scene: Mutex::new(Box::new(scene)),
-        file_sampler,
-        file_integrator,
+        description: Box::new(scene.description.clone()),
+        camera: Box::new(scene.camera.clone()),
+        slot: SceneSlot::new(scene),
         path,
     })
+}
+
+/// Builds the scene of a file as `obscura render` reads it: TOML as it is, a .pbrt or .xml
+/// through obscura-import (errors moved to the imported file's lines), with the import's
+/// warnings.
+fn build_scene(path: &Path) -> PyResult<(RenderScene, Vec<String>)> {
+    if !obscura_import::is_importable(path) {
+        let d = load_description(path).map_err(render_err)?;
+        return Ok((RenderScene::build(d).map_err(render_err)?, Vec::new()));
+    }
+    let import_err = |e: obscura_import::ImportError| PyValueError::new_err(e.to_string());
+    let imported = obscura_import::import(path).map_err(import_err)?;
+    let d = imported.description().map_err(import_err)?;
+    let scene = RenderScene::build(d).map_err(|e| render_err(imported.locate(e)))?;
+    Ok((scene, imported.warnings))
 }
 
 /// What a render's waiting thread does between polls: report progress, check Ctrl-C.
@@ -834,10 +982,15 @@ enum Progress {
 }
 
 impl Progress {
-    /// Reports (tiles done, tiles in all); an error (KeyboardInterrupt from Ctrl-C, or the
-    /// callback's own) stops the render.
+    /// Checks for Ctrl-C, then reports (tiles done, tiles in all); an error (KeyboardInterrupt
+    /// from Ctrl-C, or the callback's own) stops the render.
     fn poll(&self, py: Python<'_>, done: u64, total: u64) -> PyResult<()> {
         py.check_signals()?;
+        self.report(py, done, total)
+    }
+
+    /// Reports (tiles done, tiles in all).
+    fn report(&self, py: Python<'_>, done: u64, total: u64) -> PyResult<()> {
         match self {
             Progress::Off => Ok(()),
             Progress::Stderr => {
@@ -856,15 +1009,18 @@ impl Progress {
 /// render(scene, spp=None, integrator=None, seed=None, threads=None, progress=False,
 ///        cube_map=False)
 ///
-/// Renders `scene` (a Scene, or a path to load) and returns its image as a float32 numpy array
+/// Renders `scene` (a Scene, or a path that load_scene reads: TOML, .pbrt or .xml) and
+/// returns its image as a float32 numpy array
 /// (H, W, 4): linear RGB and alpha (the fraction of the pixel whose camera rays hit geometry),
 /// row 0 at the top, the crop window's pixels. Equal bit for bit to the EXR of
 /// `obscura render SCENE --spp .. --integrator .. --seed ..` with the same overrides, for any
 /// `threads`. `integrator` is path, depth, distance, position, normal or albedo (the AOVs);
 /// `threads` defaults to one per core. `progress` is False, True (a line on sys.stderr) or a
-/// callable taking (tiles_done, tiles_total), called from the calling thread. Ctrl-C stops the
-/// render and raises KeyboardInterrupt; so does an exception from the progress callable. The
-/// GIL is released while rendering.
+/// callable taking (tiles_done, tiles_total), called from the calling thread every 50 ms and
+/// once at the finish (tiles_done == tiles_total). Ctrl-C stops the render and raises
+/// KeyboardInterrupt; so does an exception from the progress callable. The GIL is released
+/// while rendering. Threads may render the same Scene at once: each render waits (answering
+/// Ctrl-C) for the one before it.
 ///
 /// Several views, as `obscura render` makes them: a scene with `[camera.stereo]` renders both
 /// eyes and returns them composed (layout "side_by_side": (H, 2W, 4); "anaglyph": (H, W, 4)) or,
@@ -907,12 +1063,12 @@ fn render<'py>(
                 "integrator: unknown integrator `{name}`, expected path, depth, distance, position, normal or albedo"
             ))
         })?,
-        None => scene.file_integrator,
+        None => scene.description.integrator.kind,
     };
-    let (sampler_kind, file_spp, file_seed) = scene.file_sampler;
-    let spp = spp.unwrap_or(file_spp);
-    let seed = seed.unwrap_or(file_seed);
-    let sampler = Sampler::new(sampler_kind, spp, seed)
+    let file_sampler = &scene.description.sampler;
+    let spp = spp.unwrap_or(file_sampler.spp);
+    let seed = seed.unwrap_or(file_sampler.seed);
+    let sampler = Sampler::new(file_sampler.kind, spp, seed)
         .map_err(|e| PyValueError::new_err(format!("spp: {e}")))?;
     let progress = match progress {
         None => Progress::Off,
@@ -936,11 +1092,11 @@ fn render<'py>(
     };
 
     // The views the command line would make: cube faces, a stereo pair, or the one image.
-    let description = lock(&scene.scene).description.clone();
+    let description = &scene.description;
     if cube_map {
         let faces = pyo3::types::PyDict::new(py);
         for (face, name) in CubeFace::ALL.into_iter().zip(CUBE_FACE_NAMES) {
-            let mut view = description.clone();
+            let mut view = SceneDescription::clone(description);
             view.camera.kind = CameraKind::CubeFace;
             view.camera.face = face;
             view.camera.stereo = None;
@@ -989,15 +1145,22 @@ impl RenderRun<'_> {
             tiles_done.fetch_max(done, Ordering::Relaxed);
             tiles_total.store(total, Ordering::Relaxed);
         };
+        // The last (tiles done, tiles in all) the progress was told.
+        let mut reported = None;
         let (outcome, interrupted) = py.allow_threads(|| {
-            let mut guard = lock(&self.scene.scene);
-            guard.sampler = self.sampler.clone();
-            guard.description.sampler.spp = self.spp;
-            guard.description.sampler.seed = self.seed;
-            guard.description.integrator.kind = self.kind;
-            let own_camera = camera.map(|c| std::mem::replace(&mut guard.camera, c));
-            let rs: &RenderScene = &guard;
-            let result = std::thread::scope(|s| {
+            // Another render of this scene may have it: wait, answering Ctrl-C.
+            let check = || Python::with_gil(|py| py.check_signals());
+            let mut scene = match self.scene.slot.take(check) {
+                Ok(scene) => scene,
+                Err(e) => return (None, Some(e)),
+            };
+            scene.sampler = self.sampler.clone();
+            scene.description.sampler.spp = self.spp;
+            scene.description.sampler.seed = self.seed;
+            scene.description.integrator.kind = self.kind;
+            scene.camera = camera.unwrap_or_else(|| AnyCamera::clone(&self.scene.camera));
+            let rs: &RenderScene = &scene;
+            std::thread::scope(|s| {
                 let (tx, rx) = mpsc::channel();
                 let (cancel, on_tile) = (&cancel, &on_tile);
                 s.spawn(move || {
@@ -1020,11 +1183,12 @@ impl RenderRun<'_> {
                                     tiles_done.load(Ordering::Relaxed),
                                     tiles_total.load(Ordering::Relaxed),
                                 );
-                                if let Err(e) =
-                                    Python::with_gil(|py| progress.poll(py, done, total))
-                                {
-                                    cancel.store(true, Ordering::Relaxed);
-                                    interrupted = Some(e);
+                                match Python::with_gil(|py| progress.poll(py, done, total)) {
+                                    Ok(()) => reported = Some((done, total)),
+                                    Err(e) => {
+                                        cancel.store(true, Ordering::Relaxed);
+                                        interrupted = Some(e);
+                                    }
                                 }
                             }
                         }
@@ -1035,13 +1199,18 @@ impl RenderRun<'_> {
                         }
                     }
                 }
-            });
-            // The scene keeps its own camera for later calls.
-            if let Some(c) = own_camera {
-                guard.camera = c;
-            }
-            result
+            })
+            // Dropping the lease puts the scene back for the next render.
         });
+        // The finish is reported once: here, unless the last poll came after it.
+        let finished = interrupted.is_none() && matches!(outcome, Some(Ok(_)));
+        let end = (
+            tiles_done.load(Ordering::Relaxed),
+            tiles_total.load(Ordering::Relaxed),
+        );
+        if finished && reported != Some(end) {
+            progress.report(py, end.0, end.1)?;
+        }
         if let Progress::Stderr = progress {
             py.import("sys")?
                 .getattr("stderr")?

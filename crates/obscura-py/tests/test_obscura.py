@@ -12,6 +12,7 @@ import os
 import pathlib
 import signal
 import subprocess
+import sys
 import threading
 import _thread
 
@@ -70,12 +71,41 @@ def film_points(cam, n, seed, margin=1.0):
     ).astype(np.float32)
 
 
-@pytest.mark.parametrize("model", sorted(MODELS))
-def test_project_inverts_generate_rays(model):
+DOUBLE_GAUSS = (SCENES / "lenses" / "double-gauss-50mm.dat").as_posix()
+
+# Models with a lens, by case name: (model, [camera] table). Without lens samples,
+# generate_rays gives the ray project inverts: the lens centre's, or a lens system's chief ray.
+LENS_MODELS = {
+    "thin_lens": ("perspective", f"type = \"perspective\"\nfov = 50.0\nlens_radius = 0.2\nfocal_distance = 3.0\n{LOOK}"),
+    "orthographic_thin_lens": (
+        "orthographic",
+        f"type = \"orthographic\"\nscreen_window = [-2.0, 2.0, -1.5, 1.5]\nlens_radius = 0.2\nfocal_distance = 3.0\n{LOOK}",
+    ),
+    "realistic": (
+        "realistic",
+        f"type = \"realistic\"\nlens_file = \"{DOUBLE_GAUSS}\"\nfocus_distance = 2.0\n{LOOK}",
+    ),
+}
+
+ROUND_TRIPS = {**{m: (m, text) for m, text in MODELS.items()}, **LENS_MODELS}
+
+
+def round_trip_error(cam, xy, t):
+    """The largest distance (px) between raster positions and the projections of the points at
+    distances `t` along their default rays, and the fraction of positions with a ray."""
+    o, d, valid = cam.generate_rays(xy)
+    back, seen = cam.project((o + t * d)[valid])
+    assert seen.all()
+    return np.abs(back - xy[valid]).max(), valid.mean()
+
+
+@pytest.mark.parametrize("case", sorted(ROUND_TRIPS))
+def test_project_inverts_generate_rays(case):
+    model, table = ROUND_TRIPS[case]
     square = model == "octahedral"  # an octahedral map needs a square film
-    cam = obscura.Camera.from_toml(scene_text(MODELS[model], resolution=(48, 48) if square else (64, 48)))
+    cam = obscura.Camera.from_toml(scene_text(table, resolution=(48, 48) if square else (64, 48)))
     assert cam.model == model
-    xy = film_points(cam, 2000, seed=len(model))
+    xy = film_points(cam, 2000, seed=len(case))
     o, d, valid = cam.generate_rays(xy)
     assert o.shape == (2000, 3) and d.shape == (2000, 3) and valid.shape == (2000,)
     assert o.dtype == np.float32 and d.dtype == np.float32 and valid.dtype == np.bool_
@@ -87,7 +117,20 @@ def test_project_inverts_generate_rays(model):
     back, seen = cam.project((o + t * d)[valid])
     assert seen.all()
     err = np.abs(back - xy[valid]).max()
-    assert err < 2e-2, f"{model}: round trip off by {err} px"
+    assert err < 2e-2, f"{case}: round trip off by {err} px"
+
+
+@pytest.mark.parametrize("t", [0.5, 1.0, 100.0])
+def test_a_realistic_camera_round_trips_through_its_chief_rays(t):
+    # The shipped scene: points near the lens (0.5 m) and far away, where a ray through an
+    # off-centre part of the pupil would miss its film point by tenths of a pixel.
+    cam = obscura.Camera.from_toml(SCENES / "spheres-realistic.toml")
+    assert cam.model == "realistic"
+    w, h = cam.resolution
+    g = np.stack(np.meshgrid(np.arange(0, w, 7) + 0.5, np.arange(0, h, 7) + 0.5), -1)
+    err, covered = round_trip_error(cam, g.reshape(-1, 2).astype(np.float32), t)
+    assert covered == 1.0
+    assert err < 2e-2, f"round trip off by {err} px at t = {t}"
 
 
 def test_perspective_matches_the_pinhole_formula():
@@ -254,6 +297,9 @@ OBSCURA_BIN = os.environ.get("OBSCURA_BIN")
         ("spheres-perspective.toml", dict(spp=2, seed=3)),
         ("spheres-thin-lens.toml", dict(spp=2, integrator="albedo")),
         ("cornell-box.toml", dict(spp=1)),
+        # Imported through obscura-import, as the command line imports them.
+        ("spheres-perspective.pbrt", dict(spp=2, seed=5)),
+        ("spheres-perspective.xml", dict(spp=1)),
     ],
 )
 def test_render_equals_the_command_line(tmp_path, scene, flags):
@@ -289,6 +335,26 @@ def test_progress_callback_and_its_exception(perspective_scene):
         obscura.render(perspective_scene, spp=100000, progress=stop)
 
 
+@pytest.mark.parametrize("spp", [1, 2, 16])
+def test_progress_reports_the_finish_once(perspective_scene, spp):
+    # However soon the render ends after the last 50 ms poll (a 1-spp render may end before
+    # the first), the last call is the finish, and it comes once.
+    calls = []
+    obscura.render(perspective_scene, spp=spp, progress=lambda done, total: calls.append((done, total)))
+    assert calls, "the callback was never called"
+    total = calls[-1][1]
+    assert total > 0 and calls[-1] == (total, total)
+    assert calls.count((total, total)) == 1
+
+
+def test_progress_line_ends_at_100_percent(perspective_scene, capsys):
+    obscura.render(perspective_scene, spp=1, progress=True)
+    err = capsys.readouterr().err
+    assert err.endswith("(100%)\n"), repr(err[-80:])
+    done, total = err.rsplit("rendering: ", 1)[1].split(" tiles")[0].split("/")
+    assert done == total
+
+
 def test_ctrl_c_raises_keyboard_interrupt(perspective_scene):
     # interrupt_main is what the SIGINT handler does: the render's next check of the signals
     # raises KeyboardInterrupt and stops the workers. A process started in the background by a
@@ -312,6 +378,109 @@ def test_ctrl_c_raises_keyboard_interrupt(perspective_scene):
     finally:
         timer.cancel()
         signal.signal(signal.SIGINT, previous)
+
+
+# Run in a process of its own (argv[1]: a scene file), so that a deadlock fails the test by
+# its timeout instead of hanging the suite. Each render that the others race with runs until
+# its progress callable says stop, so nothing here waits on a clock.
+RENDERS_IN_THREADS = r"""
+import _thread, signal, sys, threading
+import obscura
+
+scene = obscura.load_scene(sys.argv[1])
+errors = []
+
+
+class Stop(Exception):
+    pass
+
+
+def render_until(stop):
+    # A long render in another thread, stopped by its progress callable once stop(polls) is
+    # true; returns the thread once the render runs (it has polled).
+    started = threading.Event()
+    polls = [0]
+
+    def progress(done, total):
+        polls[0] += 1
+        started.set()
+        if stop(polls[0]):
+            raise Stop()
+
+    def run():
+        try:
+            obscura.render(scene, spp=10**6, threads=1, progress=progress)
+        except Stop:
+            pass
+        except BaseException as e:
+            errors.append(e)
+
+    thread = threading.Thread(target=run)
+    thread.start()
+    assert started.wait(60), "the render never polled"
+    return thread
+
+
+# Reading the scene while another thread renders it.
+read = threading.Event()
+t = render_until(lambda polls: read.is_set())
+assert scene.camera.model == "perspective" and scene.resolution == (320, 240)
+read.set()
+t.join()
+
+# Rendering the scene while another thread renders it: this one waits its turn.
+t = render_until(lambda polls: polls >= 5)
+assert obscura.render(scene, spp=1).shape == (240, 320, 4)
+t.join()
+
+# Ctrl-C while waiting for the other render ends the wait (interrupt_main is what the SIGINT
+# handler does; the handler is installed in case SIGINT came ignored).
+signal.signal(signal.SIGINT, signal.default_int_handler)
+interrupted = threading.Event()
+
+
+def stop_once_interrupted(polls):
+    if polls == 3:
+        _thread.interrupt_main()
+    assert polls < 200, "Ctrl-C did not end the wait for the other render"
+    return interrupted.is_set()
+
+
+t = render_until(stop_once_interrupted)
+try:
+    obscura.render(scene, spp=1)
+    errors.append("no KeyboardInterrupt")
+except KeyboardInterrupt:
+    interrupted.set()
+t.join()
+
+
+# Four threads rendering the scene at once, three times over.
+def one():
+    try:
+        obscura.render(scene, spp=1)
+    except BaseException as e:
+        errors.append(e)
+
+
+for _ in range(3):
+    threads = [threading.Thread(target=one) for _ in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+assert not errors, errors
+print("ok")
+"""
+
+
+def test_renders_in_threads_neither_deadlock_nor_ignore_ctrl_c():
+    cmd = [sys.executable, "-c", RENDERS_IN_THREADS, str(SCENES / "spheres-perspective.toml")]
+    try:
+        run = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
+    except subprocess.TimeoutExpired:
+        pytest.fail("renders in threads deadlocked (no end in 120 s)")
+    assert run.returncode == 0 and run.stdout == "ok\n", run.stderr
 
 
 # Bad input: each a Python exception with a message that says what is wrong.
@@ -372,6 +541,71 @@ def test_bad_scene_names_file_key_and_line(tmp_path):
         obscura.load_scene(tmp_path / "missing.toml")
     with pytest.raises(ValueError, match="cannot read the scene file"):
         obscura.Camera.from_toml(str(tmp_path / "missing.toml"))
+
+
+# What Camera.from_toml ignores, each of which the renderer refuses: (text before the scene,
+# text after it).
+REFUSED_TABLES = {
+    "unknown table": ("", "[foo]\nbar = 1\n"),
+    "unknown integrator": ("", '[integrator]\ntype = "nope"\n'),
+    "zero spp": ("", "[sampler]\nspp = 0\n"),
+    "undefined material": (
+        "",
+        '[[shapes]]\ntype = "sphere"\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\nmaterial = "undefined"\n',
+    ),
+    "unknown material type": ("", '[materials.x]\ntype = "nonsense"\n'),
+    "unknown light": ("", '[[lights]]\ntype = "laser"\n'),
+    "root and dotted keys": ('version = 3\nsampler.spp = 0\nmaterials.y.type = "nonsense"\n', ""),
+}
+
+
+@pytest.mark.parametrize("case", sorted(REFUSED_TABLES))
+def test_from_toml_ignores_tables_other_than_camera_and_film(tmp_path, case):
+    head, tail = REFUSED_TABLES[case]
+    text = head + scene_text(MODELS["perspective"], extra=tail)
+    # The renderer refuses the scene ...
+    path = tmp_path / "scene.toml"
+    path.write_text(text)
+    with pytest.raises(ValueError):
+        obscura.load_scene(path)
+    # ... but its camera is all there is to read, from text and from the file alike.
+    for source in (text, path):
+        cam = obscura.Camera.from_toml(source)
+        assert cam.model == "perspective" and cam.resolution == (64, 48)
+
+
+def test_from_toml_errors_keep_their_lines_after_ignored_tables(tmp_path):
+    # Ignored tables before the camera, one with a matrix whose rows start lines with "[": the
+    # error in the camera still names the camera's key and its line in the file.
+    ignored = (
+        '[integrator]\ntype = "nope"\n'
+        '[[shapes]]\ntype = "mesh"\nfile = "x.obj"\ntransform = [\n'
+        "  [1.0, 0.0, 0.0, 0.0],\n  [0.0, 1.0, 0.0, 0.0],\n  [0.0, 0.0, 1.0, 0.0],\n"
+        "  [0.0, 0.0, 0.0, 1.0],\n]\n"
+    )
+    text = ignored + '[film]\nresolution = [64, 48]\n[camera]\ntype = "perspective"\nfov = 180.0\n'
+    line = text.splitlines().index("fov = 180.0") + 1
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text)
+    with pytest.raises(ValueError) as e:
+        obscura.Camera.from_toml(bad)
+    assert f"{bad}:{line}:" in str(e.value) and "camera.fov" in str(e.value)
+    # A syntax error anywhere is still an error, with its line.
+    with pytest.raises(ValueError, match=r"<string>:2:"):
+        obscura.Camera.from_toml(scene_text(MODELS["perspective"]).replace("[film]", "[film"))
+
+
+def test_from_toml_keeps_the_sampler_type_for_pixel_rays():
+    # [sampler] type is the one key outside [camera] and [film] that counts: pixel_rays draws
+    # from that sampler (the rest of the table, spp 0 here, is ignored).
+    base = scene_text(MODELS["perspective"], resolution=(8, 6))
+    sobol = obscura.Camera.from_toml(base).pixel_rays(spp=4, seed=1)[1]
+    halton = obscura.Camera.from_toml(base + '[sampler]\ntype = "halton"\nspp = 0\n').pixel_rays(spp=4, seed=1)[1]
+    explicit = obscura.Camera.from_toml(base + '[sampler]\ntype = "sobol"\n').pixel_rays(spp=4, seed=1)[1]
+    assert (bits(explicit) == bits(sobol)).all()
+    assert not (bits(halton) == bits(sobol)).all()
+    with pytest.raises(ValueError, match="sampler.type"):
+        obscura.Camera.from_toml(base + '[sampler]\ntype = "nope"\n')
 
 
 def test_bad_opencv_arguments():
@@ -468,6 +702,34 @@ def test_bad_out_arrays_raise(cam):
         cam.generate_rays(xy, out=(o, o, v))
     with pytest.raises(TypeError, match="out: valid must be a C-contiguous bool"):
         cam.project(np.zeros((4, 3)), out=(np.empty((4, 2), np.float32), np.empty(4, np.uint8)))
+
+
+@pytest.mark.parametrize("name", ["spheres-perspective.pbrt", "spheres-perspective.xml"])
+def test_load_scene_imports_pbrt_and_mitsuba_scenes(name):
+    # The shipped pbrt-v4 and Mitsuba 3 versions of spheres-perspective.toml: the same film,
+    # samples and camera (its pose imported as a matrix, so equal to rounding), and a picture.
+    scene = obscura.load_scene(SCENES / name)
+    assert scene.resolution == (320, 240) and scene.spp == 16
+    toml = obscura.Camera.from_toml(SCENES / "spheres-perspective.toml")
+    xy = film_points(toml, 500, seed=2, margin=0.0)
+    for got, expect in zip(scene.camera.generate_rays(xy), toml.generate_rays(xy)):
+        np.testing.assert_allclose(got, expect, atol=1e-5)
+    image = obscura.render(SCENES / name, spp=1)
+    assert image.shape == (240, 320, 4) and np.isfinite(image).all()
+    # The floor fills the bottom row, the sky the top one.
+    assert image[-1, :, 3].min() == 1.0 and image[0, :, 3].max() == 0.0
+
+
+def test_a_bad_pbrt_scene_names_its_file_and_line(tmp_path):
+    bad = tmp_path / "bad.pbrt"
+    bad.write_text(
+        'LookAt 0 0 5  0 0 0  0 1 0\nCamera "perspective" "float fov" [ 40 ]\n'
+        'Film "rgb" "integer xresolution" [ 0 ] "integer yresolution" [ 24 ]\nWorldBegin\n'
+    )
+    with pytest.raises(ValueError, match=f"{bad}:3"):
+        obscura.load_scene(bad)
+    with pytest.raises(ValueError, match=f"{bad}:3"):
+        obscura.render(bad)
 
 
 STEREO = """

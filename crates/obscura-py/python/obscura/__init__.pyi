@@ -24,7 +24,9 @@ class Camera:
     def from_toml(text_or_path: Union[str, "os.PathLike[str]"]) -> "Camera":
         """The camera of a scene file's [camera] and [film] tables, from its TOML text or path.
 
-        Raises ValueError naming the file, key and line for a bad scene."""
+        [sampler] type is read too (pixel_rays draws from that sampler); every other table is
+        ignored, even one the renderer would refuse. Raises ValueError naming the file, key and
+        line for a bad camera or film."""
     @staticmethod
     def from_opencv(
         K: _ArrayLike, dist: _ArrayLike, rvec: _ArrayLike, tvec: _ArrayLike, size: Tuple[int, int]
@@ -58,8 +60,10 @@ class Camera:
     ) -> Tuple[_F32, _F32, _Bool]:
         """Rays through raster positions (N, 2) -> (origins (N, 3), directions (N, 3), valid (N,)).
 
-        lens_uv (N, 2) in [0, 1)^2 (default the lens centre 0.5); time is the shutter sample u in
-        [0, 1) (a number or (N,); default 0). Where no ray leaves, valid is False and the ray NaN.
+        lens_uv (N, 2) in [0, 1)^2. Without it each film point gets the ray project inverts: the
+        lens centre's (0.5, 0.5) for a thin lens; for a realistic camera the chief ray, through
+        the centre of the aperture stop. time is the shutter sample u in [0, 1) (a number or
+        (N,); default 0). Where no ray leaves, valid is False and the ray NaN.
         out=(origins, directions, valid): C-contiguous float32 (N, 3), float32 (N, 3) and bool
         (N,) arrays to write into (and return) instead of new ones; every element is written."""
     def project(
@@ -101,7 +105,10 @@ class Scene:
         """The scene's camera."""
 
 def load_scene(path: _PathLike) -> Scene:
-    """Read, validate and build a scene file; ValueError names the file, key and line."""
+    """Read, validate and build a scene file; ValueError names the file, key and line.
+
+    TOML, or a pbrt-v4 (.pbrt) or Mitsuba 3 (.xml) scene imported as `obscura render` imports
+    it (what the import approximates or leaves out comes as a UserWarning)."""
 
 def render(
     scene: Union[Scene, _PathLike],
@@ -114,8 +121,11 @@ def render(
 ) -> Union[_F32, Tuple[_F32, _F32], Dict[str, _F32]]:
     """Render to a float32 (H, W, 4) linear RGBA array, equal bit for bit to `obscura render`.
 
-    integrator: path, depth, distance, position, normal or albedo. progress: False, True (a line
-    on stderr) or a callable (tiles_done, tiles_total). Ctrl-C raises KeyboardInterrupt.
+    scene: a Scene or a path (TOML, .pbrt or .xml, as load_scene reads it). integrator: path,
+    depth, distance, position, normal or albedo. progress: False, True (a line on stderr) or a
+    callable (tiles_done, tiles_total), called every 50 ms and once at the finish
+    (tiles_done == tiles_total). Ctrl-C raises KeyboardInterrupt. Threads may render the same
+    Scene at once: each render waits for the one before it.
     A `[camera.stereo]` scene gives both eyes composed as its layout says ("side_by_side":
     (H, 2W, 4), "anaglyph": (H, W, 4)) or, for "separate", a tuple (left, right).
     cube_map=True gives a dict {"px", "nx", "py", "ny", "pz", "nz"} of the six faces, as
