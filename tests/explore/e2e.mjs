@@ -6,7 +6,7 @@
 // along the view), not asked of the server.
 import { chromium } from 'playwright-core';
 import { spawn, spawnSync } from 'node:child_process';
-import { mkdirSync, writeFileSync } from 'node:fs';
+import { mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 import { dirname, join } from 'node:path';
 import { fileURLToPath } from 'node:url';
 
@@ -45,11 +45,13 @@ function sphereDepth(s, x, y) {
   const disc = b * b - 4 * a * c;
   return disc < 0 ? null : (-b - Math.sqrt(disc)) / (2 * a);
 }
-// Raster position of a world point (the inverse of `direction`).
-function project(p) {
+// Raster position of a world point (the inverse of `direction`); `zoom` > 1 for a screen
+// window `zoom` times smaller than the default about the same centre.
+function project(p, zoom = 1) {
   const v = p.map((c, i) => c - EYE[i]);
   const z = -v[2];
-  return [((v[0] / z / TAN + ASPECT) / (2 * ASPECT)) * W, ((1 - v[1] / z / TAN) / 2) * H];
+  const t = TAN / zoom;
+  return [((v[0] / z / t + ASPECT) / (2 * ASPECT)) * W, ((1 - v[1] / z / t) / 2) * H];
 }
 // Raster radius of a sphere's silhouette (small-angle: r / distance in units of the fov).
 function rasterRadius(s) {
@@ -63,21 +65,26 @@ function check(name, ok, detail = '') {
   console.log(`${ok ? 'ok' : 'FAILED'} - ${name}${detail ? ` (${detail})` : ''}`);
 }
 
-// Start the server on a free loopback port and read its URL.
-const server = spawn(obscura, ['serve', scenePath, '--port', '0', '--threads', '2'], {
-  stdio: ['ignore', 'pipe', 'inherit'],
-});
-const url = await new Promise((resolve, reject) => {
-  let text = '';
-  const timer = setTimeout(() => reject(new Error('no URL from obscura serve in 60 s')), 60000);
-  server.stdout.on('data', (chunk) => {
-    text += chunk;
-    const m = text.match(/http:\/\/127\.0\.0\.1:\d+\//);
-    if (m) { clearTimeout(timer); resolve(m[0]); }
+// Starts `obscura serve` on a scene on a free loopback port: the process and its URL.
+async function serve(scene) {
+  const proc = spawn(obscura, ['serve', scene, '--port', '0', '--threads', '2'], {
+    stdio: ['ignore', 'pipe', 'inherit'],
   });
-  server.on('exit', (code) => reject(new Error(`obscura serve exited with ${code}`)));
-});
+  const address = await new Promise((resolve, reject) => {
+    let text = '';
+    const timer = setTimeout(() => reject(new Error('no URL from obscura serve in 60 s')), 60000);
+    proc.stdout.on('data', (chunk) => {
+      text += chunk;
+      const m = text.match(/http:\/\/127\.0\.0\.1:\d+\//);
+      if (m) { clearTimeout(timer); resolve(m[0]); }
+    });
+    proc.on('exit', (code) => reject(new Error(`obscura serve exited with ${code}`)));
+  });
+  return [proc, address];
+}
+const [server, url] = await serve(scenePath);
 console.log(`# server at ${url}`);
+const servers = [server];
 
 const browser = await chromium.launch({ executablePath: browserPath, args: ['--no-sandbox'] });
 try {
@@ -229,13 +236,128 @@ try {
   await page.waitForFunction(() => (window.explorer.lastError || '').includes('camera.near'));
   check('a refused value is reported with its key', true);
 
+  // The controls added for the rest of the scene format's [camera] keys. `setControl` types
+  // into a field and waits for either the last pass of the new view or an error.
+  async function setControl(key, text) {
+    const id = 'c-' + key.replace('.', '-');
+    const gen = await page.evaluate(() => { window.explorer.lastError = null; return window.explorer.generation; });
+    await page.evaluate(([id, text]) => { document.getElementById(id).value = text; }, [id, text]);
+    await page.locator('#' + id).dispatchEvent('change');
+    await page.waitForFunction((g) => {
+      const s = window.explorer;
+      return s.lastError || (s.generation > g && s.frame.generation === s.generation && s.frame.pass === s.frame.passes);
+    }, gen, { timeout: 120000 });
+    return page.evaluate(() => {
+      const c = document.getElementById('view');
+      return { error: window.explorer.lastError, camera: window.explorer.camera,
+        px: Array.from(c.getContext('2d').getImageData(0, 0, c.width, c.height).data) };
+    });
+  }
+  function meanDiff(a, b) {
+    let d = 0;
+    for (let i = 0; i < a.length; i++) d += Math.abs(a[i] - b[i]);
+    return d / a.length;
+  }
+  // The centroid of the blue sphere's pixels (blue well above red: not the grey floor, the
+  // red sphere or the black sky).
+  function blueCentroid(px) {
+    let sx = 0, sy = 0, n = 0;
+    for (let y = 0; y < H; y++) {
+      for (let x = 0; x < W; x++) {
+        const i = (y * W + x) * 4;
+        if (px[i + 2] - px[i] > 60 && px[i + 2] > px[i + 1]) { sx += x + 0.5; sy += y + 0.5; n++; }
+      }
+    }
+    return [sx / n, sy / n];
+  }
+  const near = (a, b, tol) => Math.hypot(a[0] - b[0], a[1] - b[1]) < tol;
+  const fmt2 = (p) => `(${p[0].toFixed(2)}, ${p[1].toFixed(2)})`;
+  {
+    // A pinhole first, so the silhouettes are sharp.
+    const lensGen = await page.evaluate(() => window.explorer.generation);
+    await page.locator('#c-lens_radius').fill('0');
+    const pinhole = await finalFrame(lensGen);
+    const at = blueCentroid(pinhole.px), want = project(BLUE.c);
+    check('the pinhole view puts the far sphere where the geometry says', near(at, want, 1.5),
+      `centroid ${fmt2(at)}, projected centre ${fmt2(want)}`);
+
+    // screen_window: 1.5 times smaller than the default [-4/3, 4/3, -1, 1], so the picture
+    // zooms 1.5 times about its centre.
+    const zoomed = await setControl('screen_window', '-0.8888889, 0.8888889, -0.6666667, 0.6666667');
+    check('the screen_window control is taken', !zoomed.error && zoomed.camera.screen_window?.length === 4,
+      zoomed.error || JSON.stringify(zoomed.camera.screen_window));
+    const zat = blueCentroid(zoomed.px), zwant = project(BLUE.c, 1.5);
+    check('screen_window zooms the render about its centre', meanDiff(pinhole.px, zoomed.px) > 2 && near(zat, zwant, 1.5),
+      `mean |difference| ${meanDiff(pinhole.px, zoomed.px).toFixed(2)}; centroid ${fmt2(zat)}, projected centre ${fmt2(zwant)}`);
+    await page.screenshot({ path: join(out, '4-screen-window.png') });
+    const back = await setControl('screen_window', '');
+    check('an emptied screen_window is removed', !back.error && !('screen_window' in back.camera) && meanDiff(pinhole.px, back.px) === 0,
+      back.error || `mean |difference| from the pinhole ${meanDiff(pinhole.px, back.px)}`);
+
+    // [camera.stereo]: a key of the sub-table; the page says what it shows of a pair.
+    const pair = await setControl('stereo.convergence', '5');
+    const notice = await page.locator('#notice').textContent();
+    check('the stereo controls set [camera.stereo]', !pair.error && pair.camera.stereo?.convergence === 5 &&
+      notice.includes('camera.stereo'), pair.error || `${JSON.stringify(pair.camera.stereo)}; notice ${JSON.stringify(notice)}`);
+    const single = await setControl('stereo.convergence', '');
+    check('emptying the last stereo key removes [camera.stereo]', !single.error && !('stereo' in single.camera),
+      single.error || JSON.stringify(single.camera));
+
+    // pose: the look-at's own matrix (world from camera: camera x, y, z along world x, y, -z,
+    // at the eye) renders the same picture; the look-at keys go, since the pose is given one
+    // way at a time.
+    const posed = await setControl('pose', '1, 0, 0, 0,  0, 1, 0, 1,  0, 0, -1, 6,  0, 0, 0, 1');
+    const eyeField = await page.locator('#c-eye').inputValue();
+    check('the pose control replaces the look-at', !posed.error && posed.camera.pose?.length === 16 &&
+      !('eye' in posed.camera) && eyeField === '', posed.error || `${JSON.stringify(posed.camera)}; eye field ${JSON.stringify(eyeField)}`);
+    check('the look-at\'s matrix as pose renders the look-at\'s picture', meanDiff(pinhole.px, posed.px) < 0.05,
+      `mean |difference| ${meanDiff(pinhole.px, posed.px).toFixed(4)}`);
+    // rvec, tvec: OpenCV extrinsics (world -> OpenCV camera: x right, y down, z forward along
+    // world x, -y, -z here): R a half turn about x, t = -R eye = (0, 1, 6): the same view again.
+    const cv = await setControl('tvec', '0, 1, 6');
+    check('the extrinsics controls replace the matrix, rvec filled in', !cv.error && !('pose' in cv.camera) &&
+      JSON.stringify(cv.camera.rvec) === '[0,0,0]', cv.error || JSON.stringify(cv.camera));
+    const turned = await setControl('rvec', String(Math.PI) + ', 0, 0');
+    check('OpenCV extrinsics of the same view render the same picture', !turned.error && meanDiff(pinhole.px, turned.px) < 0.05,
+      turned.error || `mean |difference| ${meanDiff(pinhole.px, turned.px).toFixed(4)}`);
+    await page.screenshot({ path: join(out, '5-extrinsics.png') });
+  }
+
+  // A scene file beyond the explorer's limits is previewed at them, and the page says so.
+  {
+    const bigPath = join(out, 'beyond-the-limits.toml');
+    writeFileSync(bigPath, readFileSync(scenePath, 'utf8')
+      .replace('resolution = [160, 120]', 'resolution = [5000, 10]')
+      .replace('spp = 16', 'spp = 10000000'));
+    const [bigServer, bigUrl] = await serve(bigPath);
+    servers.push(bigServer);
+    const big = await browser.newPage({ viewport: { width: 1400, height: 900 } });
+    big.on('pageerror', (e) => pageErrors.push(String(e)));
+    await big.goto(bigUrl);
+    await big.waitForFunction(() => window.explorer.frame.generation === 0, null, { timeout: 120000 });
+    const seen = await big.evaluate(() => ({
+      notice: document.getElementById('notice').textContent,
+      w: document.getElementById('res-w').value, h: document.getElementById('res-h').value,
+      spp: document.getElementById('spp').value,
+      canvas: [document.getElementById('view').width, document.getElementById('view').height],
+      passes: window.explorer.frame.passes,
+    }));
+    check('a scene beyond the limits is previewed at them', seen.w === '4096' && seen.h === '8' && seen.spp === '65536' &&
+      seen.canvas.join('x') === '4096x8' && seen.passes === 65536, JSON.stringify({ ...seen, notice: undefined }));
+    check('the page says which settings are previewed at the limits',
+      ['film.resolution', '5000 x 10', '4096 x 8', 'sampler.spp', '10000000'].every((w) => seen.notice.includes(w)),
+      JSON.stringify(seen.notice));
+    await big.screenshot({ path: join(out, '6-beyond-the-limits.png') });
+    await big.close();
+  }
+
   check('no page errors', pageErrors.length === 0, pageErrors.join('; '));
   check('no request leaves the server', outside.length === 0, outside.join(', '));
 } catch (e) {
   check('the scenario ran to its end', false, e.stack || String(e));
 } finally {
   await browser.close();
-  server.kill('SIGTERM');
+  for (const s of servers) s.kill('SIGTERM');
 }
 console.log(`${passed} passed, ${failed} failed`);
 process.exit(failed === 0 ? 0 : 1);

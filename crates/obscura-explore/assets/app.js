@@ -5,18 +5,22 @@
 const PROJECTIVE = ['perspective', 'orthographic'];
 const OPENCV = ['opencv', 'opencv_fisheye'];
 
-// One entry per [camera] key (docs/scene-format.md). `models` lists the camera types the key
-// applies to (absent: all). A new camera model is one entry in /api/scene's types plus entries
-// here for its own keys.
+// One entry per [camera] key (docs/scene-format.md); a key of a sub-table is dotted
+// (`stereo.interaxial` is [camera.stereo] interaxial). `models` lists the camera types the key
+// applies to (absent: all). `pose` names the way of giving the pose a key belongs to: a
+// look-at, OpenCV extrinsics or a matrix, one way at a time. A new camera model is one entry
+// in /api/scene's types plus entries here for its own keys.
 const CONTROLS = [
   { key: 'type', kind: 'select', options: [] /* from /api/scene */ },
   { key: 'fov', kind: 'range', min: 1, max: 179, step: 0.5, def: 90,
     models: ['perspective', 'fisheye', 'cylindrical'] },
   { key: 'fov_axis', kind: 'select', options: ['smaller', 'larger', 'x', 'y', 'diagonal'],
     def: 'smaller', models: ['perspective'] },
-  { key: 'eye', kind: 'vec', n: 3, def: [0, 0, 0] },
-  { key: 'target', kind: 'vec', n: 3, def: [0, 0, -1] },
-  { key: 'up', kind: 'vec', n: 3, def: [0, 1, 0] },
+  { key: 'screen_window', kind: 'vec', n: 4, optional: true, placeholder: '(from the fov)',
+    models: PROJECTIVE },
+  { key: 'eye', kind: 'vec', n: 3, def: [0, 0, 0], pose: 'look-at' },
+  { key: 'target', kind: 'vec', n: 3, def: [0, 0, -1], pose: 'look-at' },
+  { key: 'up', kind: 'vec', n: 3, def: [0, 1, 0], pose: 'look-at' },
   { key: 'lens_radius', kind: 'range', min: 0, max: 1, step: 0.005, def: 0, models: PROJECTIVE },
   { key: 'focal_distance', kind: 'range', min: 0.05, max: 50, step: 0.01, def: 1,
     models: PROJECTIVE },
@@ -25,8 +29,16 @@ const CONTROLS = [
   { key: 'aperture_rotation', kind: 'range', min: 0, max: 360, step: 1, def: 0,
     models: [...PROJECTIVE, 'realistic'] },
   { key: 'shutter', kind: 'vec', n: 2, def: [0, 1] },
-  { key: 'eye_end', kind: 'vec', n: 3, optional: true },
-  { key: 'target_end', kind: 'vec', n: 3, optional: true },
+  { key: 'eye_end', kind: 'vec', n: 3, optional: true, pose: 'look-at' },
+  { key: 'target_end', kind: 'vec', n: 3, optional: true, pose: 'look-at' },
+  { key: 'up_end', kind: 'vec', n: 3, optional: true, pose: 'look-at' },
+  // Shown `exact`: an edit elsewhere in the field must not round an imported pose.
+  { key: 'rvec', kind: 'vec', n: 3, optional: true, pose: 'extrinsics', exact: true },
+  { key: 'tvec', kind: 'vec', n: 3, optional: true, pose: 'extrinsics', exact: true },
+  { key: 'pose', kind: 'vec', n: 16, optional: true, pose: 'matrix', exact: true,
+    placeholder: '16 numbers, row-major' },
+  { key: 'pose_end', kind: 'vec', n: 16, optional: true, pose: 'matrix', exact: true,
+    placeholder: '16 numbers, row-major' },
   { key: 'near', kind: 'number', def: 0.001 },
   { key: 'far', kind: 'number', def: 1e30 },
   { key: 'lens_shift', kind: 'vec', n: 2, def: [0, 0],
@@ -56,7 +68,17 @@ const CONTROLS = [
   { key: 'aperture_diameter', kind: 'number', optional: true, models: ['realistic'] },
   { key: 'focus_distance', kind: 'number', def: 10, models: ['realistic'] },
   { key: 'film_diagonal', kind: 'number', def: 35, models: ['realistic'] },
+  { key: 'stereo.interaxial', kind: 'number', optional: true, placeholder: '0.065',
+    models: ['perspective', 'ods'] },
+  { key: 'stereo.convergence', kind: 'number', optional: true, models: ['perspective'] },
+  { key: 'stereo.layout', kind: 'select', options: ['side_by_side', 'separate', 'anaglyph'],
+    def: 'side_by_side', models: ['perspective'] },
 ];
+
+// The ways of giving the pose: the keys that always go together, and what the others' fields
+// say while one is in use.
+const POSE_PAIRS = { extrinsics: ['rvec', 'tvec'], matrix: ['pose'] };
+const POSE_NAMES = { 'look-at': 'eye, target, up', extrinsics: 'rvec, tvec', matrix: 'pose' };
 
 const $ = (id) => document.getElementById(id);
 const canvas = $('view');
@@ -65,7 +87,7 @@ const ctx = canvas.getContext('2d', { willReadFrequently: true });
 // What the page knows; window.explorer lets tests read it.
 const state = {
   session: null, camera: {}, resolution: [1, 1], spp: 1, generation: 0,
-  frame: { generation: -1, pass: 0, passes: 0 }, effective: {}, lastError: null,
+  frame: { generation: -1, pass: 0, passes: 0 }, effective: {}, clamped: [], lastError: null,
 };
 window.explorer = state;
 
@@ -79,11 +101,36 @@ function currentType() {
   return state.camera.type || 'perspective';
 }
 
+// The [camera] key a control's key lives under (`stereo` for `stereo.interaxial`).
+function topKey(key) {
+  return key.split('.')[0];
+}
+
+// The element id of a control's input.
+function idOf(key) {
+  return 'c-' + key.replace('.', '-');
+}
+
+// The value of a (dotted) key in the view's [camera] table, or undefined.
+function cameraValue(key) {
+  const [top, sub] = key.split('.');
+  const v = state.camera[top];
+  if (sub === undefined) return v;
+  return v && typeof v === 'object' ? v[sub] : undefined;
+}
+
 function valueOf(key) {
-  if (key in state.camera) return state.camera[key];
+  const v = cameraValue(key);
+  if (v !== undefined) return v;
   if (key in state.effective) return state.effective[key];
   const c = CONTROLS.find((c) => c.key === key);
   return c ? c.def : undefined;
+}
+
+// How the view gives its pose: 'look-at' unless it has extrinsics or a matrix.
+function activePose() {
+  const c = CONTROLS.find((c) => c.pose && c.pose !== 'look-at' && c.key in state.camera);
+  return c ? c.pose : 'look-at';
 }
 
 function send(change) {
@@ -91,12 +138,38 @@ function send(change) {
 }
 
 function setCamera(key, value) {
-  const change = { camera: { [key]: value } };
+  const change = { camera: {} };
+  const [top, sub] = key.split('.');
+  if (sub === undefined) {
+    change.camera[key] = value;
+  } else {
+    // A key of a sub-table: the whole table goes, with this key changed (none left: removed).
+    const table = { ...(state.camera[top] || {}) };
+    if (value === null) delete table[sub];
+    else table[sub] = value;
+    change.camera[top] = Object.keys(table).length ? table : null;
+  }
   if (key === 'type') {
-    // Drop the keys the new model does not take.
+    // Drop the keys (and tables) the new model does not take.
+    const kept = new Set(CONTROLS.filter((c) => applies(c, value)).map((c) => topKey(c.key)));
     for (const c of CONTROLS) {
-      if (c.key in state.camera && !applies(c, value)) change.camera[c.key] = null;
+      const t = topKey(c.key);
+      if (t in state.camera && !kept.has(t)) change.camera[t] = null;
     }
+  }
+  const pose = (CONTROLS.find((c) => c.key === key) || {}).pose;
+  if (pose && value !== null) {
+    // One way of giving the pose at a time: the others' keys go.
+    for (const c of CONTROLS) {
+      if (c.pose && c.pose !== pose && c.key in state.camera) change.camera[c.key] = null;
+    }
+    // Extrinsics come in pairs: the other at its value, else zero.
+    for (const k of pose === 'extrinsics' ? POSE_PAIRS.extrinsics : []) {
+      if (!(k in change.camera)) change.camera[k] = state.camera[k] || [0, 0, 0];
+    }
+  } else if (pose && value === null && POSE_PAIRS[pose] && POSE_PAIRS[pose].includes(key)) {
+    // Without its partner (rvec, tvec) or its start (pose), the rest cannot stay.
+    for (const c of CONTROLS) if (c.pose === pose && c.key in state.camera) change.camera[c.key] = null;
   }
   send(change);
 }
@@ -118,13 +191,13 @@ function buildControls(types) {
     label.append(name);
     if (c.kind === 'select') {
       const sel = document.createElement('select');
-      sel.id = 'c-' + c.key;
+      sel.id = idOf(c.key);
       for (const o of c.options) sel.append(new Option(o, o));
       sel.addEventListener('change', () => setCamera(c.key, sel.value));
       label.append(sel);
     } else if (c.kind === 'range') {
       const input = document.createElement('input');
-      Object.assign(input, { type: 'range', min: c.min, max: c.max, step: c.step, id: 'c-' + c.key });
+      Object.assign(input, { type: 'range', min: c.min, max: c.max, step: c.step, id: idOf(c.key) });
       const out = document.createElement('output');
       input.addEventListener('input', () => {
         out.textContent = input.value;
@@ -133,13 +206,17 @@ function buildControls(types) {
       label.append(input, out);
     } else if (c.kind === 'int' || c.kind === 'number') {
       const input = document.createElement('input');
-      Object.assign(input, { type: 'number', id: 'c-' + c.key, step: c.kind === 'int' ? 1 : 'any' });
-      input.addEventListener('change', () => setCamera(c.key, Number(input.value)));
+      Object.assign(input, { type: 'number', id: idOf(c.key), step: c.kind === 'int' ? 1 : 'any',
+        placeholder: c.placeholder || (c.optional ? '(none)' : '') });
+      input.addEventListener('change', () => {
+        if (input.value.trim() === '' && c.optional) return setCamera(c.key, null);
+        setCamera(c.key, Number(input.value));
+      });
       label.append(input);
     } else if (c.kind === 'vec' || c.kind === 'list') {
       const input = document.createElement('input');
-      Object.assign(input, { type: 'text', id: 'c-' + c.key, size: 16,
-        placeholder: c.optional ? '(none)' : '' });
+      Object.assign(input, { type: 'text', id: idOf(c.key), size: 16,
+        placeholder: c.placeholder || (c.optional ? '(none)' : '') });
       input.addEventListener('change', () => {
         const text = input.value.trim();
         if (text === '' && (c.optional || c.kind === 'list')) return setCamera(c.key, null);
@@ -152,7 +229,7 @@ function buildControls(types) {
       // A string (a file name, relative to the scene file) or a value written as JSON (a
       // curve of [t, openness] pairs, a table).
       const input = document.createElement('input');
-      Object.assign(input, { type: 'text', id: 'c-' + c.key, size: 16,
+      Object.assign(input, { type: 'text', id: idOf(c.key), size: 16,
         placeholder: c.placeholder || (c.optional ? '(none)' : '') });
       input.addEventListener('change', () => {
         const text = input.value.trim();
@@ -175,16 +252,23 @@ function fmt(v) {
 
 function showControls() {
   const type = currentType();
+  const pose = activePose();
   for (const c of CONTROLS) {
     const label = document.querySelector(`label[data-key="${c.key}"]`);
     if (!label) continue;
     label.classList.toggle('hidden', !applies(c, type));
-    const input = $('c-' + c.key);
+    const input = $(idOf(c.key));
     if (document.activeElement === input && c.kind !== 'range') continue;
-    const v = valueOf(c.key);
-    if (c.kind === 'vec' || c.kind === 'list') input.value = v === undefined ? '' : v.map(fmt).join(', ');
+    // The keys of another way of giving the pose show empty while this one is in use.
+    const unused = c.pose && c.pose !== pose;
+    if (c.pose) {
+      input.placeholder = unused ? `(pose from ${POSE_NAMES[pose]})` : c.placeholder || (c.optional ? '(none)' : '');
+    }
+    const v = unused ? undefined : valueOf(c.key);
+    if (c.kind === 'vec' || c.kind === 'list') input.value = v === undefined ? '' : v.map(c.exact ? String : fmt).join(', ');
     else if (c.kind === 'json') input.value = v === undefined ? '' : JSON.stringify(v);
     else if (v !== undefined) input.value = v;
+    else if (c.kind !== 'select' && c.kind !== 'range') input.value = '';
     if (c.kind === 'range') label.querySelector('output').textContent = fmt(Number(input.value));
   }
   $('res-w').value = state.resolution[0];
@@ -201,14 +285,27 @@ function showError(message) {
   $('error').textContent = message || '';
 }
 
+// What the page shows differs from what the scene file asks for: the settings previewed at
+// the explorer's limits, and a stereo pair shown from between its eyes.
+function showNotices() {
+  const notes = state.clamped.map((c) => c.message);
+  if (currentType() === 'perspective' && state.camera.stereo) {
+    notes.push('camera.stereo: the explorer shows the view from midway between the eyes; ' +
+      '`obscura render` writes the pair as its layout says');
+  }
+  $('notice').textContent = notes.join(' · ');
+}
+
 function takeView(msg) {
   state.camera = msg.camera || {};
   state.resolution = msg.resolution;
   state.spp = msg.spp;
+  state.clamped = msg.clamped || [];
   state.effective = msg.effective || {};
   if (msg.generation !== undefined) state.generation = msg.generation;
   showError(null);
   showControls();
+  showNotices();
   scheduleCompare();
 }
 
@@ -276,6 +373,9 @@ canvas.addEventListener('pointermove', (e) => {
   const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
   if (!drag.moved && Math.hypot(dx, dy) < 4) return;
   drag.moved = true;
+  if (activePose() !== 'look-at') {
+    return showError(`orbit: the pose comes from ${POSE_NAMES[activePose()]}; dragging orbits a look-at (eye, target)`);
+  }
   const [ex, ey, ez] = drag.eye, [tx, ty, tz] = drag.target;
   const v = [ex - tx, ey - ty, ez - tz];
   const r = Math.hypot(...v);

@@ -25,7 +25,17 @@ pub enum ExploreError {
     /// Nothing is under the pixel asked about, or it is off the film.
     #[error("{0}")]
     NothingThere(String),
-    /// The request is malformed (bad JSON, missing fields).
+    /// A value in the request is malformed for its key: not a number, a negative or
+    /// fractional count, a number JSON cannot hold, an unknown field. `key` is the scene key
+    /// (`camera.fov`, `sampler.spp`) or the query parameter (`session`).
+    #[error("{key}: {message}")]
+    Malformed {
+        /// The key at fault.
+        key: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// The request is malformed where no key is at fault (not JSON, not an object).
     #[error("bad request: {0}")]
     BadRequest(String),
     /// The server could not do what was asked (a thread pool, a listener, an encoder).
@@ -38,7 +48,9 @@ impl ExploreError {
     pub fn key(&self) -> Option<String> {
         match self {
             ExploreError::Render(RenderError::Scene { key, .. }) => key.clone(),
-            ExploreError::Refused { key, .. } => Some(key.clone()),
+            ExploreError::Refused { key, .. } | ExploreError::Malformed { key, .. } => {
+                Some(key.clone())
+            }
             _ => None,
         }
     }
@@ -48,7 +60,9 @@ impl ExploreError {
         match self {
             ExploreError::Render(RenderError::Io { .. } | RenderError::Encode { .. })
             | ExploreError::Internal(_) => StatusCode::INTERNAL_SERVER_ERROR,
-            ExploreError::Render(_) | ExploreError::BadRequest(_) => StatusCode::BAD_REQUEST,
+            ExploreError::Render(_)
+            | ExploreError::Malformed { .. }
+            | ExploreError::BadRequest(_) => StatusCode::BAD_REQUEST,
             ExploreError::Refused { .. } | ExploreError::NothingThere(_) => {
                 StatusCode::UNPROCESSABLE_ENTITY
             }

@@ -3,7 +3,10 @@
 //! camera's keys, orbits, focuses on a click and compares distributed with post-process blur.
 //!
 //! - [`View`] is a scene file with a page's changes to its `[camera]` keys, resolution and spp,
-//!   validated by re-parsing with the scene layer (so the errors name the same keys);
+//!   validated by re-parsing with the scene layer (so the errors name the same keys), and
+//!   rendered within the explorer's limits ([`MAX_EDGE`], [`MAX_PIXELS`], [`MAX_SPP`]): a
+//!   page asking for more is refused, a scene file asking for more is previewed at them
+//!   ([`Clamp`]);
 //! - [`Session`] is one page: its scene built once, one worker thread rendering its view pass by
 //!   pass, cancelled and restarted on every change;
 //! - [`router`] is the API and the embedded page (no outside hosts); [`run`] serves it.
@@ -12,6 +15,7 @@
 #![deny(missing_docs)]
 
 mod error;
+mod request;
 mod server;
 mod session;
 mod view;
@@ -19,7 +23,7 @@ mod view;
 pub use error::ExploreError;
 pub use server::{Explorer, MAX_SESSIONS, camera_types, router};
 pub use session::{Frame, Session, Status, coordinates, depth_at, png_bytes};
-pub use view::{MAX_EDGE, MAX_PIXELS, MAX_SPP, View, ViewChange};
+pub use view::{Clamp, MAX_EDGE, MAX_PIXELS, MAX_SPP, View, ViewChange};
 
 use std::io::Write;
 use std::net::{IpAddr, SocketAddr};
@@ -42,6 +46,9 @@ pub struct ServeOptions {
 /// serves until the process is stopped.
 pub fn run(options: ServeOptions) -> Result<(), ExploreError> {
     let view = View::load(&options.scene)?;
+    for clamp in view.clamps() {
+        eprintln!("obscura serve: note: {}", clamp.message);
+    }
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
         .enable_all()

@@ -1,12 +1,14 @@
 //! The HTTP and WebSocket API (docs/explorer.md lists it) and the embedded page.
 
 use crate::error::ExploreError;
+use crate::request::{Params, pixel};
 use crate::session::{Session, coordinates, depth_at, png_bytes};
 use crate::view::{MAX_EDGE, MAX_PIXELS, MAX_SPP, View, ViewChange};
 use axum::Router;
 use axum::body::Bytes;
+use axum::extract::ws::rejection::WebSocketUpgradeRejection;
 use axum::extract::ws::{Message, WebSocket, WebSocketUpgrade};
-use axum::extract::{Path as UrlPath, Query, State};
+use axum::extract::{Path as UrlPath, State};
 use axum::http::{StatusCode, header};
 use axum::response::{IntoResponse, Response};
 use axum::routing::{get, post};
@@ -14,7 +16,6 @@ use obscura_render::{
     CameraKind, DepthOfField, ImageInfo, RenderOptions, RenderScene, depth_of_field, motion_blur,
     render, screen_buffers, write_image,
 };
-use serde::Deserialize;
 use serde_json::{Value as Json, json};
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
@@ -98,6 +99,12 @@ impl Explorer {
         }
     }
 
+    /// The session a request must name (`?session=ID`).
+    fn named_session(&self, q: &Params) -> Result<Arc<Session>, ExploreError> {
+        let id = q.required_session()?;
+        self.session(Some(id))?.ok_or(ExploreError::NoSession(id))
+    }
+
     fn view_of(&self, id: Option<u64>) -> Result<View, ExploreError> {
         Ok(match self.session(id)? {
             Some(s) => s.view(),
@@ -141,12 +148,6 @@ pub fn router(explorer: Arc<Explorer>) -> Router {
 
 type Api = State<Arc<Explorer>>;
 
-/// `?session=ID`, where a request may name a page's session.
-#[derive(Deserialize)]
-struct SessionQuery {
-    session: Option<u64>,
-}
-
 async fn index() -> Response {
     (
         [(header::CONTENT_TYPE, "text/html; charset=utf-8")],
@@ -170,13 +171,15 @@ async fn asset(UrlPath(file): UrlPath<String>) -> Response {
     ([(header::CONTENT_TYPE, kind)], body).into_response()
 }
 
-/// The view's parameters as the page shows them.
+/// The view's parameters as the page shows them: `resolution` and `spp` as rendered, and
+/// `clamped` the scene file's settings previewed at the explorer's limits.
 fn view_json(view: &View) -> Json {
     let d = view.description();
     json!({
         "camera": view.camera_json(),
         "resolution": d.film.resolution,
         "spp": d.sampler.spp,
+        "clamped": view.clamps(),
         "effective": {
             "type": d.camera.kind.name(),
             "lens_radius": d.camera.lens.radius,
@@ -187,11 +190,8 @@ fn view_json(view: &View) -> Json {
     })
 }
 
-async fn scene_json(
-    State(x): Api,
-    Query(q): Query<SessionQuery>,
-) -> Result<Response, ExploreError> {
-    let view = x.view_of(q.session)?;
+async fn scene_json(State(x): Api, q: Params) -> Result<Response, ExploreError> {
+    let view = x.view_of(q.session()?)?;
     let mut body = view_json(&view);
     body["types"] = json!(camera_types());
     body["limits"] = json!({ "max_edge": MAX_EDGE, "max_pixels": MAX_PIXELS, "max_spp": MAX_SPP });
@@ -206,33 +206,19 @@ async fn open_session(State(x): Api) -> Result<Response, ExploreError> {
     Ok((StatusCode::CREATED, axum::Json(body)).into_response())
 }
 
-async fn close_session(
-    State(x): Api,
-    Query(q): Query<SessionQuery>,
-) -> Result<Response, ExploreError> {
-    let id = q
-        .session
-        .ok_or_else(|| ExploreError::BadRequest("no session named".into()))?;
+async fn close_session(State(x): Api, q: Params) -> Result<Response, ExploreError> {
+    let id = q.required_session()?;
     x.sessions()
         .remove(&id)
         .map(|_| StatusCode::NO_CONTENT.into_response())
         .ok_or(ExploreError::NoSession(id))
 }
 
-/// Parses a JSON body, turning every malformation into a 400 with serde's message.
-fn parse_body<T: serde::de::DeserializeOwned>(body: &Bytes) -> Result<T, ExploreError> {
-    serde_json::from_slice(body).map_err(|e| ExploreError::BadRequest(e.to_string()))
-}
-
 /// Applies a change to a session's view (restarting its render), or, without a session,
 /// only validates it against the scene file's view.
-async fn change_view(
-    State(x): Api,
-    Query(q): Query<SessionQuery>,
-    body: Bytes,
-) -> Result<Response, ExploreError> {
-    let change: ViewChange = parse_body(&body)?;
-    let mut out = match x.session(q.session)? {
+async fn change_view(State(x): Api, q: Params, body: Bytes) -> Result<Response, ExploreError> {
+    let change = ViewChange::from_json(&body)?;
+    let mut out = match x.session(q.session()?)? {
         Some(s) => {
             let (generation, view) = s.change(&change)?;
             let mut v = view_json(&view);
@@ -245,19 +231,9 @@ async fn change_view(
     Ok(axum::Json(out).into_response())
 }
 
-async fn status(State(x): Api, Query(q): Query<SessionQuery>) -> Result<Response, ExploreError> {
-    let s = x
-        .session(q.session)?
-        .ok_or_else(|| ExploreError::BadRequest("no session named".into()))?;
+async fn status(State(x): Api, q: Params) -> Result<Response, ExploreError> {
+    let s = x.named_session(&q)?;
     Ok(axum::Json(s.status()).into_response())
-}
-
-/// A raster position, as the page sends it.
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct Pixel {
-    x: f32,
-    y: f32,
 }
 
 /// Runs blocking work (ray casts, scene builds, renders) off the async runtime.
@@ -270,13 +246,9 @@ async fn blocking<T: Send + 'static>(
 }
 
 /// Autofocus: the depth under the pixel becomes the session's focal distance.
-async fn focus(
-    State(x): Api,
-    Query(q): Query<SessionQuery>,
-    body: Bytes,
-) -> Result<Response, ExploreError> {
-    let Pixel { x: px, y: py } = parse_body(&body)?;
-    match x.session(q.session)? {
+async fn focus(State(x): Api, q: Params, body: Bytes) -> Result<Response, ExploreError> {
+    let (px, py) = pixel(&body)?;
+    match x.session(q.session()?)? {
         Some(s) => {
             let depth = {
                 let s = s.clone();
@@ -302,27 +274,15 @@ async fn focus(
     }
 }
 
-#[derive(Deserialize)]
-struct CoordsQuery {
-    session: Option<u64>,
-    x: f32,
-    y: f32,
-}
-
-async fn coords(State(x): Api, Query(q): Query<CoordsQuery>) -> Result<Response, ExploreError> {
-    if !(q.x.is_finite() && q.y.is_finite()) {
-        return Err(ExploreError::BadRequest("x and y must be finite".into()));
-    }
-    let view = x.view_of(q.session)?;
+async fn coords(State(x): Api, q: Params) -> Result<Response, ExploreError> {
+    let (px, py) = (q.finite("x")?, q.finite("y")?);
+    let view = x.view_of(q.session()?)?;
     let camera = obscura_render::camera_of(view.description())?;
-    Ok(axum::Json(coordinates(&camera, q.x, q.y)).into_response())
+    Ok(axum::Json(coordinates(&camera, px, py)).into_response())
 }
 
-async fn scene_toml(
-    State(x): Api,
-    Query(q): Query<SessionQuery>,
-) -> Result<Response, ExploreError> {
-    let view = x.view_of(q.session)?;
+async fn scene_toml(State(x): Api, q: Params) -> Result<Response, ExploreError> {
+    let view = x.view_of(q.session()?)?;
     Ok((
         [
             (header::CONTENT_TYPE, "application/toml; charset=utf-8"),
@@ -336,17 +296,15 @@ async fn scene_toml(
         .into_response())
 }
 
-fn latest(x: &Explorer, id: Option<u64>) -> Result<(obscura_render::Image, u32), ExploreError> {
-    let s = x
-        .session(id)?
-        .ok_or_else(|| ExploreError::BadRequest("no session named".into()))?;
+fn latest(x: &Explorer, q: &Params) -> Result<(obscura_render::Image, u32), ExploreError> {
+    let s = x.named_session(q)?;
     s.latest_image()
         .map(|(image, _, passes)| (image, passes))
         .ok_or_else(|| ExploreError::NothingThere("no frame rendered yet".into()))
 }
 
-async fn image_png(State(x): Api, Query(q): Query<SessionQuery>) -> Result<Response, ExploreError> {
-    let (image, _) = latest(&x, q.session)?;
+async fn image_png(State(x): Api, q: Params) -> Result<Response, ExploreError> {
+    let (image, _) = latest(&x, &q)?;
     let png = blocking(move || png_bytes(&image)).await?;
     Ok((
         [
@@ -361,8 +319,8 @@ async fn image_png(State(x): Api, Query(q): Query<SessionQuery>) -> Result<Respo
         .into_response())
 }
 
-async fn image_exr(State(x): Api, Query(q): Query<SessionQuery>) -> Result<Response, ExploreError> {
-    let (image, passes) = latest(&x, q.session)?;
+async fn image_exr(State(x): Api, q: Params) -> Result<Response, ExploreError> {
+    let (image, passes) = latest(&x, &q)?;
     let exr = blocking(move || {
         // The EXR writer writes files; a private temporary one, read back and removed.
         let path = std::env::temp_dir().join(format!(
@@ -400,28 +358,20 @@ async fn image_exr(State(x): Api, Query(q): Query<SessionQuery>) -> Result<Respo
 
 static TEMP_COUNTER: AtomicU64 = AtomicU64::new(0);
 
-#[derive(Deserialize)]
-struct PostprocessQuery {
-    session: Option<u64>,
-    effect: String,
-}
-
 /// Potmesil and Chakravarty's post-process blur of a pinhole image of the view, for
 /// comparison with the distributed render.
-async fn postprocess(
-    State(x): Api,
-    Query(q): Query<PostprocessQuery>,
-) -> Result<Response, ExploreError> {
-    let dof = match q.effect.as_str() {
+async fn postprocess(State(x): Api, q: Params) -> Result<Response, ExploreError> {
+    let dof = match q.text("effect")? {
         "dof" => true,
         "motion" => false,
         other => {
-            return Err(ExploreError::BadRequest(format!(
-                "effect must be \"dof\" or \"motion\", got {other:?}"
-            )));
+            return Err(ExploreError::Malformed {
+                key: "effect".into(),
+                message: format!("must be \"dof\" or \"motion\", got {other:?}"),
+            });
         }
     };
-    let view = x.view_of(q.session)?;
+    let view = x.view_of(q.session()?)?;
     let threads = x.threads;
     let png = blocking(move || {
         let d = view.description();
@@ -463,14 +413,18 @@ async fn postprocess(
 
 async fn websocket(
     State(x): Api,
-    Query(q): Query<SessionQuery>,
-    upgrade: WebSocketUpgrade,
+    q: Params,
+    upgrade: Result<WebSocketUpgrade, WebSocketUpgradeRejection>,
 ) -> Result<Response, ExploreError> {
+    // Checked before a session is opened for the socket, so that a refused upgrade leaves
+    // none behind.
+    let upgrade = upgrade.map_err(|e| ExploreError::BadRequest(e.body_text()))?;
     // A named session is joined (and left open); otherwise the page gets its own, closed
     // with the socket.
-    let joined = x.session(q.session)?;
+    let named = q.session()?;
+    let joined = x.session(named)?;
     let (id, session, owned) = match joined {
-        Some(s) => (q.session.unwrap_or_default(), s, false),
+        Some(s) => (named.unwrap_or_default(), s, false),
         None => {
             let (id, s) = x.open().await?;
             (id, s, true)
@@ -526,8 +480,7 @@ async fn talk(mut socket: WebSocket, id: u64, session: Arc<Session>) {
                     Some(Ok(Message::Close(_))) | None | Some(Err(_)) => return,
                     Some(Ok(_)) => continue,
                 };
-                let reply = match serde_json::from_str::<ViewChange>(text.as_str())
-                    .map_err(|e| ExploreError::BadRequest(e.to_string()))
+                let reply = match ViewChange::from_json(text.as_bytes())
                     .and_then(|c| session.change(&c))
                 {
                     Ok((generation, view)) => {

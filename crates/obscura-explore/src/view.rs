@@ -4,35 +4,144 @@
 //! A change is applied to the TOML document and the whole text parsed again by
 //! [`obscura_render::parse_description`], so the explorer accepts exactly what a scene file
 //! accepts and its errors name the same keys.
+//!
+//! The explorer's limits (film edges, pixels, spp) hold for what it renders. A page asking
+//! for more is refused; a scene file asking for more is previewed at the limits (the film
+//! scaled down in proportion, the spp capped), the view says so in [`View::clamps`], and the
+//! saved scene file keeps the file's own values.
 
 use crate::error::ExploreError;
+use crate::request::{keyed, parse_keyed};
 use obscura_render::{RenderError, SceneDescription, parse_description};
-use serde::Deserialize;
 use serde_json::Value as Json;
 use std::path::{Path, PathBuf};
 use toml::{Table, Value as Toml};
 
-/// The largest film edge a page may ask for, in pixels.
+/// The largest film edge the explorer renders, in pixels.
 pub const MAX_EDGE: u32 = 4096;
-/// The most pixels a page may ask for (a 2048 x 2048 film).
+/// The most pixels the explorer renders (a 2048 x 2048 film).
 pub const MAX_PIXELS: u64 = 2048 * 2048;
-/// The most samples per pixel a page may ask for.
+/// The most samples per pixel the explorer renders.
 pub const MAX_SPP: u32 = 65_536;
 
 /// A change a page asks for. Every field is optional; `camera` keys set to `null` are removed
 /// (so that switching the model can drop the old model's keys).
-#[derive(Clone, Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Clone, Debug, Default)]
 pub struct ViewChange {
     /// `[camera]` keys, as the scene format spells them, with JSON values.
-    #[serde(default)]
     pub camera: serde_json::Map<String, Json>,
     /// `[film] resolution`.
-    #[serde(default)]
     pub resolution: Option<[u32; 2]>,
     /// `[sampler] spp`.
-    #[serde(default)]
     pub spp: Option<u32>,
+}
+
+impl ViewChange {
+    /// Reads a change from its JSON text,
+    /// `{"camera": {KEY: VALUE, ...}, "resolution": [W, H], "spp": N}`. An error names the
+    /// key at fault as the scene format does (`camera.fov`, `film.resolution`,
+    /// `sampler.spp`): a malformed value is [`ExploreError::Malformed`], a count beyond what
+    /// the explorer renders [`ExploreError::Refused`].
+    pub fn from_json(text: &[u8]) -> Result<ViewChange, ExploreError> {
+        let value = parse_keyed(text).map_err(|(key, message)| {
+            // The request's `resolution` and `spp` are the scene's `film.resolution` and
+            // `sampler.spp`.
+            let key = key.map(|k| match k.split('.').next() {
+                Some("resolution") => "film.resolution".to_string(),
+                Some("spp") => "sampler.spp".to_string(),
+                _ => k,
+            });
+            keyed(key, message)
+        })?;
+        let Json::Object(fields) = value else {
+            return Err(ExploreError::BadRequest(format!(
+                "a change is a JSON object with camera, resolution or spp, got {value}"
+            )));
+        };
+        let mut change = ViewChange::default();
+        for (key, value) in fields {
+            match key.as_str() {
+                "camera" => match value {
+                    Json::Object(keys) => change.camera = keys,
+                    Json::Null => {}
+                    other => {
+                        return Err(ExploreError::Malformed {
+                            key: "camera".into(),
+                            message: format!(
+                                "must be an object of [camera] keys and values, got {other}"
+                            ),
+                        });
+                    }
+                },
+                "resolution" => {
+                    change.resolution = match &value {
+                        Json::Null => None,
+                        Json::Array(edges) if edges.len() == 2 => Some([
+                            count("film.resolution", &edges[0], MAX_EDGE)?,
+                            count("film.resolution", &edges[1], MAX_EDGE)?,
+                        ]),
+                        other => {
+                            return Err(ExploreError::Malformed {
+                                key: "film.resolution".into(),
+                                message: format!("must be [width, height] in pixels, got {other}"),
+                            });
+                        }
+                    }
+                }
+                "spp" => {
+                    change.spp = match &value {
+                        Json::Null => None,
+                        v => Some(count("sampler.spp", v, MAX_SPP)?),
+                    }
+                }
+                other => {
+                    return Err(ExploreError::Malformed {
+                        key: other.into(),
+                        message: "unknown field; a change has camera, resolution and spp".into(),
+                    });
+                }
+            }
+        }
+        Ok(change)
+    }
+}
+
+/// A count (pixels, samples) from JSON, at most `max`: a whole number >= 0 (malformed
+/// otherwise); refused when too large for a u32 (smaller ones past `max`, and 0, are refused
+/// by [`View::apply`]).
+fn count(key: &str, value: &Json, max: u32) -> Result<u32, ExploreError> {
+    let whole = match value {
+        Json::Number(n) => n.as_u64().or_else(|| {
+            n.as_f64()
+                .filter(|v| *v >= 0.0 && v.fract() == 0.0 && *v < u64::MAX as f64)
+                .map(|v| v as u64)
+        }),
+        _ => None,
+    };
+    let Some(whole) = whole else {
+        return Err(ExploreError::Malformed {
+            key: key.into(),
+            message: format!("must be a whole number from 1 to {max}, got {value}"),
+        });
+    };
+    u32::try_from(whole).map_err(|_| ExploreError::Refused {
+        key: key.into(),
+        message: format!("must be at most {max}, got {whole}"),
+    })
+}
+
+/// A scene-file setting the explorer renders below the file's value, to stay within its
+/// limits.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Clamp {
+    /// The scene key: `film.resolution` or `sampler.spp`.
+    pub key: &'static str,
+    /// The scene file's value.
+    pub file: Json,
+    /// The value the explorer renders.
+    pub rendered: Json,
+    /// Says so, for the page.
+    pub message: String,
 }
 
 /// A scene file and the view a page has made of it.
@@ -42,8 +151,10 @@ pub struct View {
     path: PathBuf,
     /// The document, with the page's changes.
     doc: Table,
-    /// The validated description of `doc`.
+    /// The validated description of `doc`, as the explorer renders it: within its limits.
     description: SceneDescription,
+    /// The scene file's settings that `description` renders below their values.
+    clamps: Vec<Clamp>,
 }
 
 impl View {
@@ -57,9 +168,11 @@ impl View {
         View::parse(path, &text)
     }
 
-    /// Validates scene text as if read from `path`.
+    /// Validates scene text as if read from `path`. A resolution or spp beyond the
+    /// explorer's limits is previewed at the limits ([`View::clamps`]).
     pub fn parse(path: &Path, text: &str) -> Result<View, ExploreError> {
-        let description = parse_description(path, text)?;
+        let mut description = parse_description(path, text)?;
+        let clamps = clamp_to_limits(&mut description);
         let doc: Table = text
             .parse()
             .map_err(|e: toml::de::Error| RenderError::Scene {
@@ -72,15 +185,23 @@ impl View {
             path: path.to_path_buf(),
             doc,
             description,
+            clamps,
         })
     }
 
-    /// The validated description.
+    /// The validated description, as the explorer renders it (within its limits).
     pub fn description(&self) -> &SceneDescription {
         &self.description
     }
 
-    /// The view as a scene file (TOML text that `obscura check` accepts).
+    /// The scene file's settings that the explorer renders below their values (none when
+    /// the scene is within its limits).
+    pub fn clamps(&self) -> &[Clamp] {
+        &self.clamps
+    }
+
+    /// The view as a scene file (TOML text that `obscura check` accepts). A resolution or
+    /// spp the explorer previews at its limits keeps the scene file's value here.
     pub fn to_toml(&self) -> String {
         // Serialising a table of TOML values cannot fail.
         toml::to_string(&self.doc).unwrap_or_default()
@@ -127,7 +248,7 @@ impl View {
                 if value.is_null() {
                     camera.remove(key);
                 } else {
-                    let v = toml_of(value).ok_or_else(|| ExploreError::Refused {
+                    let v = toml_of(value).ok_or_else(|| ExploreError::Malformed {
                         key: format!("camera.{key}"),
                         message: format!("not a scene-file value: {value}"),
                     })?;
@@ -140,7 +261,7 @@ impl View {
             message: e.to_string(),
         })?;
         // The line numbers would be those of the regenerated text, not of the user's file.
-        let description = parse_description(&self.path, &text).map_err(|e| match e {
+        let mut description = parse_description(&self.path, &text).map_err(|e| match e {
             RenderError::Scene {
                 file, key, message, ..
             } => RenderError::Scene {
@@ -151,26 +272,102 @@ impl View {
             },
             other => other,
         })?;
-        let [w, h] = description.film.resolution;
-        check_resolution(w, h)?;
-        if description.sampler.spp > MAX_SPP {
-            return Err(ExploreError::Refused {
-                key: "sampler.spp".into(),
-                message: format!("must be at most {MAX_SPP}, got {}", description.sampler.spp),
-            });
-        }
+        // What the page asked for is within the limits (checked above); what the file asks
+        // for is previewed at them.
+        let clamps = clamp_to_limits(&mut description);
         Ok(View {
             path: self.path.clone(),
             doc,
             description,
+            clamps,
         })
     }
 }
 
-/// Refuses films too large to explore interactively.
+/// Whether the explorer renders a `w` x `h` film.
+fn within_limits(w: u32, h: u32) -> bool {
+    w >= 1 && h >= 1 && w <= MAX_EDGE && h <= MAX_EDGE && u64::from(w) * u64::from(h) <= MAX_PIXELS
+}
+
+/// The largest film within the explorer's limits with the shape of `w` x `h` (the shorter
+/// edge follows the longer in proportion, rounded down, at least 1; an even height stays
+/// even, as the ODS camera needs); `w` x `h` itself when within them.
+fn preview_resolution(w: u32, h: u32) -> [u32; 2] {
+    if within_limits(w, h) {
+        return [w, h];
+    }
+    let (long, short) = (w.max(h), w.min(h));
+    let follow = |l: u32| ((u64::from(l) * u64::from(short) / u64::from(long)) as u32).max(1);
+    // The longest edge that fits: `fits` only turns false as `l` grows, so bisect.
+    let fits = |l: u32| u64::from(l) * u64::from(follow(l)) <= MAX_PIXELS;
+    let (mut lo, mut hi) = (1, long.min(MAX_EDGE));
+    while lo < hi {
+        let mid = lo + (hi - lo).div_ceil(2);
+        if fits(mid) {
+            lo = mid;
+        } else {
+            hi = mid - 1;
+        }
+    }
+    let [pw, mut ph] = if w >= h {
+        [lo, follow(lo)]
+    } else {
+        [follow(lo), lo]
+    };
+    if h.is_multiple_of(2) && !ph.is_multiple_of(2) {
+        // One row less fits; one more where the film is a single row.
+        ph = if ph > 1 { ph - 1 } else { 2 };
+    }
+    [pw, ph]
+}
+
+/// Brings the resolution and spp of `d` within the explorer's limits (the film scaled down in
+/// proportion, the OpenCV intrinsics with it, so the picture keeps its framing; the spp
+/// capped), saying what it changed.
+fn clamp_to_limits(d: &mut SceneDescription) -> Vec<Clamp> {
+    let mut clamps = Vec::new();
+    let [w, h] = d.film.resolution;
+    let [pw, ph] = preview_resolution(w, h);
+    if [pw, ph] != [w, h] {
+        // OpenCV pixel centres are at integers: raster (u + 0.5) scales.
+        if let Some(k) = &mut d.camera.intrinsics {
+            let (sx, sy) = (f64::from(pw) / f64::from(w), f64::from(ph) / f64::from(h));
+            k.fx *= sx;
+            k.fy *= sy;
+            k.cx = (k.cx + 0.5) * sx - 0.5;
+            k.cy = (k.cy + 0.5) * sy - 0.5;
+        }
+        d.film.resolution = [pw, ph];
+        clamps.push(Clamp {
+            key: "film.resolution",
+            file: serde_json::json!([w, h]),
+            rendered: serde_json::json!([pw, ph]),
+            message: format!(
+                "film.resolution: the scene's {w} x {h} is previewed at {pw} x {ph}, the \
+                 explorer's limit (each edge at most {MAX_EDGE}, at most {MAX_PIXELS} pixels); \
+                 a saved scene keeps {w} x {h}"
+            ),
+        });
+    }
+    let spp = d.sampler.spp;
+    if spp > MAX_SPP {
+        d.sampler.spp = MAX_SPP;
+        clamps.push(Clamp {
+            key: "sampler.spp",
+            file: serde_json::json!(spp),
+            rendered: serde_json::json!(MAX_SPP),
+            message: format!(
+                "sampler.spp: the scene's {spp} is previewed at {MAX_SPP}, the explorer's \
+                 limit; a saved scene keeps {spp}"
+            ),
+        });
+    }
+    clamps
+}
+
+/// Refuses films a page asks for that are too large to explore interactively.
 fn check_resolution(w: u32, h: u32) -> Result<(), ExploreError> {
-    if w == 0 || h == 0 || w > MAX_EDGE || h > MAX_EDGE || u64::from(w) * u64::from(h) > MAX_PIXELS
-    {
+    if !within_limits(w, h) {
         return Err(ExploreError::Refused {
             key: "film.resolution".into(),
             message: format!(
@@ -242,7 +439,7 @@ radius = 1.0
     }
 
     fn change(json: &str) -> ViewChange {
-        serde_json::from_str(json).unwrap()
+        ViewChange::from_json(json.as_bytes()).unwrap()
     }
 
     #[test]
@@ -309,6 +506,109 @@ radius = 1.0
         assert_ne!(v.description().camera.fov, 60.0);
     }
 
+    /// The scene text with its film and spp replaced.
+    fn scene_with(resolution: [u32; 2], spp: u32) -> String {
+        SCENE
+            .replace(
+                "resolution = [32, 24]",
+                &format!("resolution = [{}, {}]", resolution[0], resolution[1]),
+            )
+            .replace("spp = 4", &format!("spp = {spp}"))
+    }
+
+    #[test]
+    fn a_scene_file_beyond_the_limits_is_previewed_at_them() {
+        let v = View::parse(
+            Path::new("test.toml"),
+            &scene_with([10_000, 10_000], 10_000_000),
+        )
+        .unwrap();
+        assert_eq!(v.description().film.resolution, [2048, 2048]);
+        assert_eq!(v.description().sampler.spp, MAX_SPP);
+        let keys: Vec<_> = v.clamps().iter().map(|c| c.key).collect();
+        assert_eq!(keys, ["film.resolution", "sampler.spp"]);
+        assert_eq!(v.clamps()[0].file, serde_json::json!([10_000, 10_000]));
+        assert_eq!(v.clamps()[0].rendered, serde_json::json!([2048, 2048]));
+        assert!(v.clamps()[0].message.contains("2048 x 2048"));
+        // A saved scene keeps the file's own values.
+        let saved = parse_description(Path::new("saved.toml"), &v.to_toml()).unwrap();
+        assert_eq!(saved.film.resolution, [10_000, 10_000]);
+        assert_eq!(saved.sampler.spp, 10_000_000);
+        // A camera change keeps the preview; a page's own resolution and spp end it.
+        let moved = v.apply(&change(r#"{"camera": {"fov": 30}}"#)).unwrap();
+        assert_eq!(moved.description().film.resolution, [2048, 2048]);
+        assert_eq!(moved.clamps(), v.clamps());
+        let own = v
+            .apply(&change(r#"{"resolution": [64, 48], "spp": 8}"#))
+            .unwrap();
+        assert_eq!(own.description().film.resolution, [64, 48]);
+        assert!(own.clamps().is_empty());
+        // Within the limits, nothing changes.
+        assert!(view().clamps().is_empty());
+        assert_eq!(view().description().film.resolution, [32, 24]);
+    }
+
+    #[test]
+    fn preview_resolutions_by_hand() {
+        for ((w, h), want) in [
+            ((10_000, 10_000), [2048, 2048]),
+            ((4096, 1024), [4096, 1024]),
+            ((2048, 2049), [2047, 2048]),
+            // 2730 x 1535 is the largest 16:9 film; the height stays even.
+            ((3840, 2160), [2730, 1534]),
+            ((5000, 10), [4096, 8]),
+            ((10, 5000), [8, 4096]),
+            ((100_000, 2), [4096, 2]),
+            ((100_000, 1), [4096, 1]),
+        ] {
+            assert_eq!(preview_resolution(w, h), want, "{w} x {h}");
+        }
+    }
+
+    #[test]
+    fn a_previewed_opencv_camera_keeps_its_framing() {
+        let text = SCENE
+            .replace("resolution = [32, 24]", "resolution = [8000, 6000]")
+            .replace(
+                "fov = 40.0",
+                "type = \"opencv\"\nfx = 5000.0\nfy = 5200.0\ncx = 4100.0\ncy = 2900.0\n\
+             distortion = [0.05, -0.01, 0.001, 0.002]",
+            );
+        let file = parse_description(Path::new("test.toml"), &text).unwrap();
+        let v = View::parse(Path::new("test.toml"), &text).unwrap();
+        let [pw, ph] = v.description().film.resolution;
+        assert_eq!([pw, ph], preview_resolution(8000, 6000));
+        let (sx, sy) = (pw as f32 / 8000.0, ph as f32 / 6000.0);
+        let (full, preview) = (
+            obscura_render::camera_of(&file).unwrap(),
+            obscura_render::camera_of(v.description()).unwrap(),
+        );
+        let direction = |camera: &obscura_camera::AnyCamera, x: f32, y: f32| {
+            use obscura_camera::Camera;
+            let p = obscura_space::Point2::<obscura_space::Raster>::new(x, y);
+            let d = camera
+                .generate_ray(&obscura_camera::CameraSample::at(p))
+                .unwrap()
+                .ray
+                .direction;
+            glam::Vec3::new(d.x, d.y, d.z).normalize()
+        };
+        for (x, y) in [
+            (4100.5, 2900.5),
+            (0.0, 0.0),
+            (7999.0, 10.0),
+            (1234.5, 5678.0),
+        ] {
+            let a = direction(&full, x, y);
+            let b = direction(&preview, x * sx, y * sy);
+            // A tenth of a full-size pixel's angle (f32 directions).
+            assert!(
+                (a - b).length() < 2e-5,
+                "raster ({x}, {y}): {a} against {b}"
+            );
+        }
+    }
+
     proptest! {
         /// The saved scene file parses back to the same description.
         #[test]
@@ -321,6 +621,34 @@ radius = 1.0
             prop_assert_eq!(again.description().camera.lens.radius, radius);
             prop_assert_eq!(again.description().camera.lens.focal_distance, focus);
             prop_assert_eq!(again.description().camera.fov, fov);
+        }
+
+        /// A preview film is within the limits, as large as they allow with the file's shape,
+        /// and the file's own film when that is within them.
+        #[test]
+        fn preview_resolution_fits_and_keeps_the_shape(w in 1u32..200_000, h in 1u32..200_000) {
+            let [pw, ph] = preview_resolution(w, h);
+            prop_assert!(within_limits(pw, ph), "{} x {}", pw, ph);
+            if within_limits(w, h) {
+                prop_assert_eq!([pw, ph], [w, h]);
+            } else {
+                let (long, short, plong, pshort) =
+                    if w >= h { (w, h, pw, ph) } else { (h, w, ph, pw) };
+                // The shorter edge follows the longer, give or take the even-height row.
+                let follow = (u64::from(plong) * u64::from(short) / u64::from(long)).max(1);
+                prop_assert!(u64::from(pshort).abs_diff(follow) <= 1, "{} x {}", pw, ph);
+                // One pixel more along the longer edge would not fit (two where the longer
+                // edge is an even height, which may have given up one to stay even).
+                let next = if w < h && h % 2 == 0 { plong + 2 } else { plong + 1 };
+                let next_short = (u64::from(next) * u64::from(short) / u64::from(long)).max(1);
+                prop_assert!(
+                    next > MAX_EDGE.min(long) || u64::from(next) * next_short > MAX_PIXELS,
+                    "{} x {}", pw, ph
+                );
+            }
+            if h % 2 == 0 {
+                prop_assert_eq!(ph % 2, 0);
+            }
         }
     }
 }

@@ -64,6 +64,42 @@ async fn call(x: &Arc<Explorer>, method: &str, uri: &str, body: &str) -> (Status
     (status, bytes.to_vec())
 }
 
+/// An answer that must be an error in the documented form: JSON `{"error": MESSAGE, "key":
+/// KEY-or-null}` with a message; its status and body.
+async fn call_error(x: &Arc<Explorer>, method: &str, uri: &str, body: &str) -> (StatusCode, Value) {
+    let request = Request::builder()
+        .method(method)
+        .uri(uri)
+        .header("content-type", "application/json")
+        .body(Body::from(body.to_string()))
+        .unwrap();
+    let response = router(x.clone()).oneshot(request).await.unwrap();
+    let status = response.status();
+    let kind = response
+        .headers()
+        .get("content-type")
+        .map(|v| v.to_str().unwrap().to_string());
+    let bytes = to_bytes(response.into_body(), 1 << 26).await.unwrap();
+    let text = String::from_utf8_lossy(&bytes);
+    assert!(
+        status.is_client_error(),
+        "{method} {uri} {body}: {status} {text}"
+    );
+    assert_eq!(
+        kind.as_deref(),
+        Some("application/json"),
+        "{method} {uri} {body}: {text}"
+    );
+    let v: Value = serde_json::from_slice(&bytes)
+        .unwrap_or_else(|e| panic!("{method} {uri} {body}: not JSON ({e}): {text}"));
+    assert!(
+        !v["error"].as_str().unwrap_or("").is_empty(),
+        "{method} {uri} {body}: {v}"
+    );
+    assert!(v.get("key").is_some(), "{method} {uri} {body}: {v}");
+    (status, v)
+}
+
 async fn call_json(x: &Arc<Explorer>, method: &str, uri: &str, body: &str) -> (StatusCode, Value) {
     let (status, bytes) = call(x, method, uri, body).await;
     let v = serde_json::from_slice(&bytes)
@@ -171,16 +207,46 @@ async fn bad_changes_get_a_4xx_that_names_the_key() {
         ),
         (r#"{"spp": 0}"#, 422, Some("sampler.spp")),
         (r#"{"spp": 4000000000}"#, 422, Some("sampler.spp")),
-        (r#"{"cameraa": {}}"#, 400, None),
-        (r#"{"camera": {"fov": "#, 400, None),
+        (r#"{"spp": 5000000000}"#, 422, Some("sampler.spp")),
+        // Malformed values: a 400 naming the key, not serde's message alone.
+        (r#"{"spp": -1}"#, 400, Some("sampler.spp")),
+        (r#"{"spp": 1.5}"#, 400, Some("sampler.spp")),
+        (r#"{"spp": "4"}"#, 400, Some("sampler.spp")),
+        (r#"{"camera": {"fov": 1e400}}"#, 400, Some("camera.fov")),
+        (
+            r#"{"camera": {"eye": [0, 0, -1e400]}}"#,
+            400,
+            Some("camera.eye"),
+        ),
+        (
+            r#"{"camera": {"eye": [0, null, 1]}}"#,
+            400,
+            Some("camera.eye"),
+        ),
+        (
+            r#"{"camera": {"stereo": {"interaxial": 1e400}}}"#,
+            400,
+            Some("camera.stereo.interaxial"),
+        ),
+        (r#"{"camera": 5}"#, 400, Some("camera")),
+        (r#"{"resolution": [-1, 2]}"#, 400, Some("film.resolution")),
+        (r#"{"resolution": [64]}"#, 400, Some("film.resolution")),
+        (
+            r#"{"resolution": [64, 1e400]}"#,
+            400,
+            Some("film.resolution"),
+        ),
+        (r#"{"cameraa": {}}"#, 400, Some("cameraa")),
+        (r#"{"camera": {"fov": "#, 400, Some("camera.fov")),
+        // No key at fault: the body is not a change at all.
         (r#"[1, 2]"#, 400, None),
-        (r#"{"resolution": [-1, 2]}"#, 400, None),
+        ("not json", 400, None),
     ] {
-        let (got, v) = call_json(&x, "POST", "/api/view", body).await;
+        let (got, v) = call_error(&x, "POST", "/api/view", body).await;
         assert_eq!(got.as_u16(), status, "{body}: {v}");
-        assert!(!v["error"].as_str().unwrap_or("").is_empty(), "{body}: {v}");
+        assert_eq!(v["key"], json!(key), "{body}: {v}");
         if let Some(key) = key {
-            assert_eq!(v["key"], json!(key), "{body}: {v}");
+            assert!(v["error"].as_str().unwrap().contains(key), "{body}: {v}");
         }
     }
     let (got, v) = call_json(&x, "POST", "/api/view", r#"{"camera": {"fov": 60}}"#).await;
@@ -189,25 +255,65 @@ async fn bad_changes_get_a_4xx_that_names_the_key() {
 }
 
 #[tokio::test]
-async fn unknown_sessions_and_bad_queries_are_4xx() {
+async fn unknown_sessions_and_bad_queries_are_4xx_in_json_naming_the_key() {
     let x = explorer(1);
-    for (method, uri, body) in [
-        ("GET", "/api/status?session=999", ""),
-        ("POST", "/api/view?session=999", "{}"),
-        ("GET", "/api/scene.toml?session=999", ""),
-        ("GET", "/api/image.png?session=999", ""),
-        ("DELETE", "/api/session?session=999", ""),
-        ("GET", "/api/coords?x=abc&y=1", ""),
-        ("GET", "/api/coords?x=NaN&y=1", ""),
-        ("POST", "/api/focus", r#"{"x": 1}"#),
-        ("POST", "/api/focus", r#"{"x": -5, "y": 3}"#),
-        ("POST", "/api/focus", r#"{"x": 1e30, "y": 3}"#),
-        ("GET", "/api/image.png", ""),
-        ("GET", "/api/postprocess.png?effect=blur", ""),
+    for (method, uri, body, key) in [
+        ("GET", "/api/status?session=999", "", None),
+        ("POST", "/api/view?session=999", "{}", None),
+        ("GET", "/api/scene.toml?session=999", "", None),
+        ("GET", "/api/image.png?session=999", "", None),
+        ("DELETE", "/api/session?session=999", "", None),
+        ("GET", "/api/scene?session=nosuch", "", Some("session")),
+        ("GET", "/api/status?session=nosuch", "", Some("session")),
+        ("POST", "/api/view?session=nosuch", "{}", Some("session")),
+        (
+            "POST",
+            "/api/focus?session=1.5",
+            r#"{"x": 1, "y": 1}"#,
+            Some("session"),
+        ),
+        ("GET", "/api/image.exr?session=-1", "", Some("session")),
+        ("DELETE", "/api/session?session=", "", Some("session")),
+        ("DELETE", "/api/session", "", Some("session")),
+        ("GET", "/api/status", "", Some("session")),
+        ("GET", "/api/image.png", "", Some("session")),
+        ("GET", "/api/coords?x=abc&y=1", "", Some("x")),
+        ("GET", "/api/coords?x=NaN&y=1", "", Some("x")),
+        ("GET", "/api/coords?x=1", "", Some("y")),
+        (
+            "GET",
+            "/api/coords?x=1&y=2&session=two",
+            "",
+            Some("session"),
+        ),
+        ("POST", "/api/focus", r#"{"x": 1}"#, Some("y")),
+        ("POST", "/api/focus", r#"{"x": 1e400, "y": 3}"#, Some("x")),
+        ("POST", "/api/focus", r#"{"x": "1", "y": 3}"#, Some("x")),
+        (
+            "POST",
+            "/api/focus",
+            r#"{"x": 1, "y": 3, "z": 0}"#,
+            Some("z"),
+        ),
+        ("POST", "/api/focus", r#"{"x": -5, "y": 3}"#, None),
+        ("POST", "/api/focus", r#"{"x": 1e30, "y": 3}"#, None),
+        ("POST", "/api/focus", "[1, 2]", None),
+        (
+            "GET",
+            "/api/postprocess.png?effect=blur",
+            "",
+            Some("effect"),
+        ),
+        ("GET", "/api/postprocess.png", "", Some("effect")),
+        // Not a WebSocket handshake; a session named or not.
+        ("GET", "/api/ws", "", None),
+        ("GET", "/api/ws?session=nosuch", "", None),
     ] {
-        let (status, _) = call(&x, method, uri, body).await;
-        assert!(status.is_client_error(), "{method} {uri} {body}: {status}");
+        let (_, v) = call_error(&x, method, uri, body).await;
+        assert_eq!(v["key"], json!(key), "{method} {uri} {body}: {v}");
     }
+    // A refused handshake opens no session.
+    assert_eq!(x.session_count(), 0);
 }
 
 #[tokio::test]
@@ -384,12 +490,18 @@ async fn the_websocket_streams_frames_and_takes_changes() {
     ws.send(Message::Text(r#"{"camera": {"fov": 400}}"#.into()))
         .await
         .unwrap();
+    ws.send(Message::Text(r#"{"spp": -1}"#.into()))
+        .await
+        .unwrap();
+    ws.send(Message::Text(r#"{"camera": {"fov": 1e400}}"#.into()))
+        .await
+        .unwrap();
     ws.send(Message::Text(r#"{"camera": {"fov": 25}}"#.into()))
         .await
         .unwrap();
     let mut replies = Vec::new();
     let mut new_frame = None;
-    while replies.len() < 2 || new_frame.is_none() {
+    while replies.len() < 4 || new_frame.is_none() {
         match ws.next().await.unwrap().unwrap() {
             Message::Text(t) => replies.push(serde_json::from_str::<Value>(t.as_str()).unwrap()),
             Message::Binary(b) if word(&b, 0) == 1 => new_frame = Some(b),
@@ -398,9 +510,13 @@ async fn the_websocket_streams_frames_and_takes_changes() {
     }
     assert_eq!(replies[0]["type"], json!("error"));
     assert_eq!(replies[0]["key"], json!("camera.fov"));
-    assert_eq!(replies[1]["type"], json!("view"));
-    assert_eq!(replies[1]["generation"], json!(1));
-    assert_eq!(replies[1]["camera"]["fov"], json!(25));
+    assert_eq!(replies[1]["type"], json!("error"));
+    assert_eq!(replies[1]["key"], json!("sampler.spp"), "{}", replies[1]);
+    assert_eq!(replies[2]["type"], json!("error"));
+    assert_eq!(replies[2]["key"], json!("camera.fov"), "{}", replies[2]);
+    assert_eq!(replies[3]["type"], json!("view"));
+    assert_eq!(replies[3]["generation"], json!(1));
+    assert_eq!(replies[3]["camera"]["fov"], json!(25));
     assert!(new_frame.is_some());
 
     // Garbage does not close the socket; it gets an error reply.
@@ -480,4 +596,81 @@ async fn pages_past_the_limit_are_refused_and_the_server_keeps_answering() {
     }
     let (status, _) = call_json(&x, "POST", "/api/session", "").await;
     assert_eq!(status, StatusCode::CREATED);
+}
+
+/// The scene of `scene_text` with its film and spp replaced.
+fn view_with(resolution: [u32; 2], spp: u32) -> View {
+    let text = scene_text(spp).replace(
+        "resolution = [48, 32]",
+        &format!("resolution = [{}, {}]", resolution[0], resolution[1]),
+    );
+    View::parse(&PathBuf::from("explore-test.toml"), &text).unwrap()
+}
+
+/// The width and height in a PNG's header.
+fn png_size(png: &[u8]) -> [u32; 2] {
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    let word = |i: usize| u32::from_be_bytes(png[i..i + 4].try_into().unwrap());
+    [word(16), word(20)]
+}
+
+#[tokio::test]
+async fn a_scene_file_beyond_the_limits_is_previewed_at_them_and_says_so() {
+    let x = Explorer::new(view_with([10_000, 10_000], 10_000_000), Some(1));
+    let (status, s) = call_json(&x, "GET", "/api/scene", "").await;
+    assert_eq!(status, StatusCode::OK, "{s}");
+    assert_eq!(s["resolution"], json!([2048, 2048]), "{s}");
+    assert_eq!(s["spp"], json!(65_536), "{s}");
+    assert_eq!(s["clamped"][0]["key"], json!("film.resolution"), "{s}");
+    assert_eq!(s["clamped"][0]["file"], json!([10_000, 10_000]), "{s}");
+    assert_eq!(s["clamped"][1]["key"], json!("sampler.spp"), "{s}");
+    assert_eq!(s["clamped"][1]["file"], json!(10_000_000), "{s}");
+
+    let (status, v) = call_json(&x, "POST", "/api/session", "").await;
+    assert_eq!(status, StatusCode::CREATED, "{v}");
+    assert_eq!(v["resolution"], json!([2048, 2048]), "{v}");
+    assert_eq!(v["clamped"], s["clamped"]);
+    let id = v["session"].as_u64().unwrap();
+    // The camera's keys still change (the file's film is not held against the page)...
+    let (status, v) = call_json(
+        &x,
+        "POST",
+        &format!("/api/view?session={id}"),
+        r#"{"camera": {"fov": 30}}"#,
+    )
+    .await;
+    assert_eq!(status, StatusCode::OK, "{v}");
+    assert_eq!(v["resolution"], json!([2048, 2048]), "{v}");
+    // ...a page asking for more than the limits is still refused...
+    let (status, v) = call_error(
+        &x,
+        "POST",
+        &format!("/api/view?session={id}"),
+        r#"{"resolution": [10000, 10000]}"#,
+    )
+    .await;
+    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{v}");
+    assert_eq!(v["key"], json!("film.resolution"));
+    // ...and the saved scene keeps the file's own film and spp.
+    let (_, toml) = call(&x, "GET", &format!("/api/scene.toml?session={id}"), "").await;
+    let saved: toml::Table = std::str::from_utf8(&toml).unwrap().parse().unwrap();
+    assert_eq!(
+        saved["film"]["resolution"],
+        toml::Value::try_from([10_000, 10_000]).unwrap()
+    );
+    assert_eq!(saved["sampler"]["spp"], toml::Value::Integer(10_000_000));
+    let (status, _) = call(&x, "DELETE", &format!("/api/session?session={id}"), "").await;
+    assert_eq!(status, StatusCode::NO_CONTENT);
+
+    // What renders is the preview: its frames are 2048 x 2048 of 65536 passes.
+    let session = Session::start(view_with([10_000, 10_000], 10_000_000), Some(1)).unwrap();
+    let frame = session
+        .frames()
+        .wait_for(|f| f.is_some())
+        .await
+        .unwrap()
+        .clone()
+        .unwrap();
+    assert_eq!(frame.passes, 65_536);
+    assert_eq!(png_size(&frame.png), [2048, 2048]);
 }
