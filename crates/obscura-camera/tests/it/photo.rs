@@ -324,29 +324,7 @@ proptest! {
         let denominator = d.z - d.y * ta - d.x * tb;
         prop_assume!(denominator > 0.05);
         let focus = d * (5.0 / denominator);
-        for i in 0..16 {
-            let u = Vec2::new((i % 4) as f32 / 4.0 + 0.1, (i / 4) as f32 / 4.0 + 0.1);
-            let ray = cam
-                .generate_ray(&CameraSample { p_lens: u, ..CameraSample::at(p_film) })
-                .unwrap()
-                .ray;
-            let o = to_camera(ray.origin);
-            let dir = to_camera_dir(ray.direction);
-            // Distance from the focus point to the ray.
-            let miss = (focus - o).cross(dir).length();
-            prop_assert!(miss < 1e-4 * focus.length().max(1.0), "miss {} at {}", miss, focus);
-            // Off the plane: at depth z = depth_factor * focus.z along this ray, the offset
-            // from the centre ray's point at that depth.
-            let z = depth_factor * focus.z;
-            let on_ray = o + dir * ((z - o.z) / dir.z);
-            let on_centre = d * (z / d.z);
-            let predicted = o.length() * (1.0 - z / focus.z).abs();
-            let spread = (on_ray - on_centre).length();
-            prop_assert!(
-                (spread - predicted).abs() < 1e-3 * (1.0 + predicted),
-                "spread {} predicted {}", spread, predicted
-            );
-        }
+        lens_rays_meet(&cam, p_film, focus, (Vec3::ZERO, d), depth_factor)?;
     }
 }
 
@@ -373,26 +351,51 @@ proptest! {
         let (ta, tb) = (tilt_x.to_radians().tan(), tilt_y.to_radians().tan());
         let focus = Vec3::new(film.x, film.y, 5.0 + film.y * ta + film.x * tb);
         prop_assume!(focus.z > 0.05);
-        for i in 0..16 {
-            let u = Vec2::new((i % 4) as f32 / 4.0 + 0.1, (i / 4) as f32 / 4.0 + 0.1);
-            let ray = cam
-                .generate_ray(&CameraSample { p_lens: u, ..CameraSample::at(p_film) })
-                .unwrap()
-                .ray;
-            let o = to_camera(ray.origin);
-            let dir = to_camera_dir(ray.direction);
-            let miss = (focus - o).cross(dir).length();
-            prop_assert!(miss < 1e-4 * focus.length().max(1.0), "miss {} at {}", miss, focus);
-            let z = depth_factor * focus.z;
-            let on_ray = o + dir * ((z - o.z) / dir.z);
-            let predicted = (o - film).length() * (1.0 - z / focus.z).abs();
-            let spread = (on_ray - Vec3::new(film.x, film.y, z)).length();
-            prop_assert!(
-                (spread - predicted).abs() < 1e-3 * (1.0 + predicted),
-                "spread {} predicted {}", spread, predicted
-            );
-        }
+        lens_rays_meet(&cam, p_film, focus, (film, Vec3::Z), depth_factor)?;
     }
+}
+
+/// Every lens sample's ray from `p_film` passes through `focus` (camera space), and off the
+/// plane spreads as the thin lens predicts: at depth `z = depth_factor * focus.z` the ray from
+/// lens point `o` is `|o - c| |1 - z / focus.z|` from the centre ray's point there, with the
+/// centre ray `(c, d)` (origin and direction, camera space) and the lens on the plane z = 0.
+fn lens_rays_meet(
+    cam: &impl Camera,
+    p_film: Point2<Raster>,
+    focus: Vec3,
+    (c, d): (Vec3, Vec3),
+    depth_factor: f32,
+) -> Result<(), TestCaseError> {
+    for i in 0..16 {
+        let u = Vec2::new((i % 4) as f32 / 4.0 + 0.1, (i / 4) as f32 / 4.0 + 0.1);
+        let sample = CameraSample {
+            p_lens: u,
+            ..CameraSample::at(p_film)
+        };
+        let ray = cam.generate_ray(&sample).unwrap().ray;
+        let o = to_camera(ray.origin);
+        let dir = to_camera_dir(ray.direction);
+        // Distance from the focus point to the ray.
+        let miss = (focus - o).cross(dir).length();
+        prop_assert!(
+            miss < 1e-4 * focus.length().max(1.0),
+            "miss {} at {}",
+            miss,
+            focus
+        );
+        let z = depth_factor * focus.z;
+        let on_ray = o + dir * ((z - o.z) / dir.z);
+        let on_centre = c + d * ((z - c.z) / d.z);
+        let predicted = (o - c).length() * (1.0 - z / focus.z).abs();
+        let spread = (on_ray - on_centre).length();
+        prop_assert!(
+            (spread - predicted).abs() < 1e-3 * (1.0 + predicted),
+            "spread {} predicted {}",
+            spread,
+            predicted
+        );
+    }
+    Ok(())
 }
 
 fn to_camera_dir(v: obscura_space::Vector3<obscura_space::World>) -> Vec3 {
