@@ -1,114 +1,36 @@
 //! Reading what a request carries, its JSON body and its query, so that every error names the
 //! key at fault (docs/explorer.md: an error is `{"error", "key"}`).
 //!
-//! A JSON body is read with a seed that notes the dotted path of the object key whose value
-//! is being read (`camera.fov`), so even an error from the JSON parser itself, such as a
-//! number out of range (`1e400`), names the key it was reading.
+//! A JSON body is read through `serde_path_to_error`, which notes the path of the value being
+//! read (`camera.fov`), so even an error from the JSON parser itself, such as a number out of
+//! range (`1e400`), names the key it was reading.
 
 use crate::error::ExploreError;
 use axum::extract::{FromRequestParts, Query};
 use axum::http::request::Parts;
-use serde::de::{DeserializeSeed, Deserializer, MapAccess, SeqAccess, Visitor};
 use serde_json::Value as Json;
-use std::cell::RefCell;
+use serde_path_to_error::Segment;
 use std::collections::HashMap;
-use std::fmt;
 
 /// Parses JSON text. On failure: the dotted path of the object key whose value was being read
-/// (None outside every object's values, as for a syntax error between keys) and serde's
-/// message.
+/// (None outside every object's values, as for a syntax error between keys; an array's
+/// elements are named by the array's key) and serde's message.
 pub(crate) fn parse_keyed(text: &[u8]) -> Result<Json, (Option<String>, String)> {
-    let at = RefCell::new(None);
     let mut de = serde_json::Deserializer::from_slice(text);
-    let value = Keyed {
-        at: &at,
-        path: None,
-    }
-    .deserialize(&mut de)
-    .and_then(|v| de.end().map(|()| v));
-    value.map_err(|e| (at.into_inner(), e.to_string()))
-}
-
-/// A JSON value at `path`, noting in `at` the path of each object key as its value is read.
-struct Keyed<'a> {
-    at: &'a RefCell<Option<String>>,
-    path: Option<String>,
-}
-
-impl<'de> DeserializeSeed<'de> for Keyed<'_> {
-    type Value = Json;
-
-    fn deserialize<D: Deserializer<'de>>(self, d: D) -> Result<Json, D::Error> {
-        d.deserialize_any(self)
-    }
-}
-
-impl<'de> Visitor<'de> for Keyed<'_> {
-    type Value = Json;
-
-    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
-        f.write_str("a JSON value")
-    }
-
-    fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<Json, A::Error> {
-        let mut out = serde_json::Map::new();
-        while let Some(key) = map.next_key::<String>()? {
-            let path = match &self.path {
-                Some(p) => format!("{p}.{key}"),
-                None => key.clone(),
-            };
-            *self.at.borrow_mut() = Some(path.clone());
-            let value = map.next_value_seed(Keyed {
-                at: self.at,
-                path: Some(path),
-            })?;
-            // Past the value: an error now (a missing comma) is this object's.
-            self.at.borrow_mut().clone_from(&self.path);
-            out.insert(key, value);
-        }
-        Ok(Json::Object(out))
-    }
-
-    fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Json, A::Error> {
-        // Elements are named by their array's key.
-        let mut out = Vec::new();
-        while let Some(v) = seq.next_element_seed(Keyed {
-            at: self.at,
-            path: self.path.clone(),
-        })? {
-            out.push(v);
-        }
-        Ok(Json::Array(out))
-    }
-
-    fn visit_bool<E>(self, v: bool) -> Result<Json, E> {
-        Ok(Json::Bool(v))
-    }
-
-    fn visit_i64<E>(self, v: i64) -> Result<Json, E> {
-        Ok(Json::from(v))
-    }
-
-    fn visit_u64<E>(self, v: u64) -> Result<Json, E> {
-        Ok(Json::from(v))
-    }
-
-    fn visit_f64<E>(self, v: f64) -> Result<Json, E> {
-        // JSON text holds no infinity or NaN; the parser refuses numbers out of f64's range.
-        Ok(serde_json::Number::from_f64(v).map_or(Json::Null, Json::Number))
-    }
-
-    fn visit_str<E>(self, v: &str) -> Result<Json, E> {
-        Ok(Json::String(v.to_owned()))
-    }
-
-    fn visit_string<E>(self, v: String) -> Result<Json, E> {
-        Ok(Json::String(v))
-    }
-
-    fn visit_unit<E>(self) -> Result<Json, E> {
-        Ok(Json::Null)
-    }
+    let value = serde_path_to_error::deserialize(&mut de).map_err(|e| {
+        let keys: Vec<&str> = e
+            .path()
+            .iter()
+            .filter_map(|s| match s {
+                Segment::Map { key } => Some(key.as_str()),
+                _ => None,
+            })
+            .collect();
+        let key = (!keys.is_empty()).then(|| keys.join("."));
+        (key, e.into_inner().to_string())
+    })?;
+    de.end().map_err(|e| (None, e.to_string()))?;
+    Ok(value)
 }
 
 /// A raster position from a JSON body `{"x": X, "y": Y}`, each finite.
@@ -224,7 +146,7 @@ mod tests {
             ),
             (r#"{"camera": {"fov": "#, Some("camera.fov")),
             (r#"{"camera": {"fov": 1} "spp": 2}"#, None),
-            (r#"{"camera": {"fov": 1, "near" 2}}"#, Some("camera.near")),
+            (r#"{"camera": {"fov": 1, "near" 2}}"#, Some("camera")),
             (r#"{"camera": {"fov": 1 "near": 2}}"#, Some("camera")),
             (r#"{"spp": 1} x"#, None),
             ("not json", None),
