@@ -77,3 +77,30 @@ pub fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     std::fs::write(&p, text).unwrap();
     p
 }
+
+/// The RMS distance by which the camera's rays from `p`'s image pass the world point `p`,
+/// over a grid of lens samples.
+pub fn miss_rms(camera: &obscura_camera::AnyCamera, p: [f32; 3]) -> f64 {
+    use obscura_camera::{Camera, CameraSample};
+    let p = obscura_space::Point3::<obscura_space::World>::new(p[0], p[1], p[2]);
+    let film = camera.project(p, 0.0).expect("the point projects");
+    let target = p.to_glam().as_dvec3();
+    let (mut sum, mut count) = (0.0, 0);
+    for i in 0..24 {
+        for j in 0..24 {
+            let sample = CameraSample {
+                p_film: film,
+                p_lens: glam::Vec2::new((i as f32 + 0.5) / 24.0, (j as f32 + 0.5) / 24.0),
+                time: 0.0,
+            };
+            if let Some(r) = camera.generate_ray(&sample) {
+                let o = r.ray.origin.to_glam().as_dvec3();
+                let d = r.ray.direction.to_glam().as_dvec3().normalize();
+                sum += (target - o).reject_from_normalized(d).length_squared();
+                count += 1;
+            }
+        }
+    }
+    assert!(count > 100, "{count} rays");
+    (sum / f64::from(count)).sqrt()
+}

@@ -1,7 +1,7 @@
 //! Issue 21's photographic controls end to end: the rolling shutter skews a moving bar by the
 //! predicted slope; exposure settings scale pixel values as photography says.
 
-use crate::render_image;
+use crate::{miss_rms, render_image};
 use obscura_render::{Image, parse_description};
 use std::path::Path;
 
@@ -180,33 +180,6 @@ fn no_exposure_keys_leave_the_image_unchanged_and_unit_keys_scale_by_one() {
     assert_eq!(plain.pixels, unit.pixels);
 }
 
-/// The RMS distance by which the rays of `p`'s image (`project`), over a grid of lens samples,
-/// pass the world point `p`.
-fn miss_rms(scene: &obscura_render::RenderScene, p: [f32; 3]) -> f64 {
-    use obscura_camera::{Camera, CameraSample};
-    let point = obscura_space::Point3::<obscura_space::World>::new(p[0], p[1], p[2]);
-    let film = scene
-        .camera
-        .project(point, 0.0)
-        .expect("the point projects");
-    let target = glam::Vec3::from(p).as_dvec3();
-    let mut sum = 0.0;
-    for i in 0..8 {
-        for j in 0..8 {
-            let sample = CameraSample {
-                p_film: film,
-                p_lens: glam::Vec2::new((i as f32 + 0.5) / 8.0, (j as f32 + 0.5) / 8.0),
-                time: 0.0,
-            };
-            let r = scene.camera.generate_ray(&sample).expect("a ray").ray;
-            let o = r.origin.to_glam().as_dvec3();
-            let d = r.direction.to_glam().as_dvec3().normalize();
-            sum += (target - o).reject_from_normalized(d).length_squared();
-        }
-    }
-    (sum / 64.0).sqrt()
-}
-
 #[test]
 fn an_orthographic_thin_lens_reads_focal_plane_tilt() {
     // Camera at world z = 5 looking down -z, so camera z = 5 - world z; focused at 5, the plane
@@ -237,7 +210,7 @@ radiance = [1.0, 1.0, 1.0]
     let flat = scene("");
     let t = 60f32.to_radians().tan();
     for p in [[0.0, 0.5, -0.5 * t], [0.3, -0.6, 0.6 * t]] {
-        let (on, off) = (miss_rms(&tilted, p), miss_rms(&flat, p));
+        let (on, off) = (miss_rms(&tilted.camera, p), miss_rms(&flat.camera, p));
         assert!(on < 1e-4, "{p:?}: tilted camera misses by {on}");
         assert!(off > 5e-3, "{p:?}: untilted camera misses by {off}");
     }

@@ -1,8 +1,8 @@
 //! The realistic camera from scene files: each shipped lens renders the spheres upright and in
 //! the places `project` gives, and a uniform sky renders as 1 at the image centre.
 
-use super::{aov, render_image, root, shipped};
-use obscura_camera::{AnyCamera, Camera, CameraSample, LensPrescription};
+use super::{aov, miss_rms, render_image, root, shipped};
+use obscura_camera::{AnyCamera, Camera, LensPrescription};
 use obscura_render::{
     FilterSettings, Image, IntegratorKind, LightSettings, RenderScene, SceneDescription,
 };
@@ -116,32 +116,6 @@ fn the_stop_takes_the_aperture_keys_of_the_scene_file() {
 
     let centre = pixel(&under_a_uniform_sky(d), 4, 4)[0];
     assert!((centre - 1.0).abs() < 0.05, "centre {centre}");
-}
-
-/// The RMS distance by which the camera's rays from `p`'s image pass the world point `p`,
-/// over a grid of lens samples.
-fn miss_rms(camera: &AnyCamera, p: [f32; 3]) -> f64 {
-    let p = Point3::<World>::new(p[0], p[1], p[2]);
-    let film = camera.project(p, 0.0).expect("the point projects");
-    let target = p.to_glam().as_dvec3();
-    let (mut sum, mut count) = (0.0, 0);
-    for i in 0..24 {
-        for j in 0..24 {
-            let sample = CameraSample {
-                p_film: film,
-                p_lens: glam::Vec2::new((i as f32 + 0.5) / 24.0, (j as f32 + 0.5) / 24.0),
-                time: 0.0,
-            };
-            if let Some(r) = camera.generate_ray(&sample) {
-                let o = r.ray.origin.to_glam().as_dvec3();
-                let d = r.ray.direction.to_glam().as_dvec3().normalize();
-                sum += (target - o).reject_from_normalized(d).length_squared();
-                count += 1;
-            }
-        }
-    }
-    assert!(count > 100, "{count} rays");
-    (sum / f64::from(count)).sqrt()
 }
 
 /// A realistic camera at the origin looking down world -z (camera +z), focused 0.5 m away
