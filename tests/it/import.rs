@@ -211,3 +211,130 @@ fn convert_writes_toml_that_renders_bit_for_bit_the_same() {
     ]);
     assert_eq!(code, 2, "{stderr}");
 }
+
+/// `obscura ARGS` run in `dir`: exit status and stderr.
+fn run_in(dir: &std::path::Path, args: &[&str]) -> (i32, String) {
+    let out = obscura().current_dir(dir).args(args).output().unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn files_an_imported_scene_names_are_found_from_any_folder_and_after_convert() {
+    // Every file a scene names (pbrt's lens file, PLY mesh and infinite-light image; Mitsuba's
+    // PLY mesh and envmap) is relative to the scene file: `check` from the folder above it and
+    // `check` of a copy converted into a subfolder must both find them.
+    let dir = scratch("import-folders");
+    let scene = dir.join("imp");
+    std::fs::create_dir_all(scene.join("lenses")).unwrap();
+    std::fs::copy(
+        root().join("scenes/lenses/double-gauss-50mm.dat"),
+        scene.join("lenses/dgauss.dat"),
+    )
+    .unwrap();
+    write(
+        &scene,
+        "tri.ply",
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+         property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n\
+         0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+    );
+    let sky = obscura_render::Image {
+        width: 4,
+        height: 4,
+        pixels: vec![[0.5, 0.5, 0.5, 1.0]; 16],
+    };
+    let info = obscura_render::ImageInfo {
+        partial: false,
+        samples_per_pixel: 1,
+    };
+    obscura_render::write_image(&scene.join("sky.exr"), &sky, &info).unwrap();
+    write(
+        &scene,
+        "real.pbrt",
+        "LookAt 0 0 5  0 0 0  0 1 0\n\
+         Camera \"realistic\" \"string lensfile\" \"lenses/dgauss.dat\" \
+         \"float aperturediameter\" 5 \"float focusdistance\" 5\n\
+         Film \"rgb\" \"integer xresolution\" 16 \"integer yresolution\" 8\nWorldBegin\n\
+         LightSource \"infinite\" \"string filename\" \"sky.exr\"\n\
+         Shape \"plymesh\" \"string filename\" \"tri.ply\"\n",
+    );
+    write(
+        &scene,
+        "env.xml",
+        "<scene version=\"3.0.0\"><sensor type=\"perspective\"/>\
+         <shape type=\"ply\"><string name=\"filename\" value=\"tri.ply\"/></shape>\
+         <emitter type=\"envmap\"><string name=\"filename\" value=\"sky.exr\"/></emitter></scene>\n",
+    );
+    for name in ["real.pbrt", "env.xml"] {
+        // From the folder above: `imp/real.pbrt`.
+        let (code, stderr) = run_in(&dir, &["check", &format!("imp/{name}")]);
+        assert_eq!(code, 0, "{name} from above: {stderr}");
+        // Converted from inside, into a subfolder, then checked from inside and from above.
+        let (code, stderr) = run_in(&scene, &["convert", name, "-o", "sub/out.toml"]);
+        assert_eq!(code, 0, "{name} converted: {stderr}");
+        let (code, stderr) = run_in(&scene, &["check", "sub/out.toml"]);
+        assert_eq!(code, 0, "{name} converted, checked: {stderr}");
+        let (code, stderr) = run_in(&dir, &["check", "imp/sub/out.toml"]);
+        assert_eq!(code, 0, "{name} converted, checked from above: {stderr}");
+    }
+}
+
+#[test]
+fn deeply_nested_xml_exits_2_naming_file_and_line() {
+    // 100,000 nested elements overflowed the XML parser's stack (an abort, exit 134). The
+    // 256th shape inside <scene> (line 257 + 1, after the sensor's line) is one level too deep.
+    let dir = scratch("import-deep");
+    let mut text = String::from("<scene version=\"3.0.0\">\n<sensor type=\"perspective\"/>\n");
+    text.push_str(&"<shape type=\"sphere\">\n".repeat(100_000));
+    text.push_str(&"</shape>".repeat(100_000));
+    text.push_str("</scene>\n");
+    let scene = write(&dir, "deep.xml", &text);
+    let out = dir.join("out.exr");
+    let toml = dir.join("out.toml");
+    for args in [
+        vec!["check", scene.to_str().unwrap()],
+        vec![
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        vec![
+            "convert",
+            scene.to_str().unwrap(),
+            "-o",
+            toml.to_str().unwrap(),
+        ],
+    ] {
+        let (code, _, stderr) = run(&args);
+        assert_eq!(code, 2, "{args:?}: {stderr}");
+        assert!(
+            stderr.contains("deep.xml:258: elements nested more than 256 deep"),
+            "{stderr}"
+        );
+        assert!(!out.exists() && !toml.exists(), "nothing is written");
+    }
+}
+
+#[test]
+fn a_motion_pbrt_cannot_be_given_exactly_exits_2_naming_transform_times() {
+    // pbrt moves the sphere over the transform times [0, 0.5] and holds it for the rest of
+    // the shutter [0, 1]: not expressible as a motion from shutter open to close.
+    let dir = scratch("import-motion");
+    let scene = write(
+        &dir,
+        "m.pbrt",
+        "LookAt 0 0 5  0 0 0  0 1 0\nTransformTimes 0 0.5\nCamera \"perspective\"\n\
+         WorldBegin\nActiveTransform EndTime\nTranslate 1 0 0\nActiveTransform All\n\
+         Shape \"sphere\"\n",
+    );
+    let (code, _, stderr) = run(&["check", scene.to_str().unwrap()]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("m.pbrt:2: TransformTimes 0 0.5") && stderr.contains("m.pbrt:8"),
+        "{stderr}"
+    );
+}

@@ -31,8 +31,20 @@ pub fn import_mitsuba(path: &Path) -> Result<Imported, ImportError> {
     parse_mitsuba(path, &text)
 }
 
+/// How deeply elements may nest. roxmltree parses an element's content by recursion, so a
+/// deep enough file overflows the stack (an abort, not an error); Mitsuba scenes nest a handful
+/// of levels, so this leaves room for any real one.
+const MAX_XML_DEPTH: usize = 256;
+
 /// Imports Mitsuba 3 XML text; `path` names it in messages and anchors relative files.
 pub fn parse_mitsuba(path: &Path, text: &str) -> Result<Imported, ImportError> {
+    check_depth(text, MAX_XML_DEPTH).map_err(|line| ImportError::Scene {
+        file: path.to_path_buf(),
+        line: Some(line),
+        message: format!(
+            "elements nested more than {MAX_XML_DEPTH} deep (a Mitsuba scene needs a few levels)"
+        ),
+    })?;
     let file = Arc::new(path.to_path_buf());
     let doc = roxmltree::Document::parse(text).map_err(|e| ImportError::Scene {
         file: path.to_path_buf(),
@@ -56,6 +68,70 @@ pub fn parse_mitsuba(path: &Path, text: &str) -> Result<Imported, ImportError> {
     }
     m.scene(root)?;
     Imported::new(path, m.ir)
+}
+
+/// Checks, before roxmltree sees the text, that no element is nested more than `limit` deep;
+/// the error is the 1-based line of the first element too deep.
+///
+/// A scan of XML's lexical structure, enough to count open elements exactly in a well-formed
+/// document: comments, CDATA sections, processing instructions and declarations are skipped,
+/// and quoted attribute values may hold `>` and `/`. On malformed text the count may be off,
+/// but roxmltree then stops at the first fault, no deeper than the scan has reached.
+fn check_depth(text: &str, limit: usize) -> Result<(), usize> {
+    let bytes = text.as_bytes();
+    let line_at = |at: usize| bytes[..at].iter().filter(|&&b| b == b'\n').count() + 1;
+    // The position just after `end` searched from `from`, or the end of the text.
+    let skip_past = |from: usize, end: &str| {
+        text[from..]
+            .find(end)
+            .map_or(bytes.len(), |i| from + i + end.len())
+    };
+    let mut depth = 0usize;
+    let mut at = 0;
+    while let Some(i) = text[at..].find('<') {
+        let start = at + i;
+        let rest = &text[start..];
+        if rest.starts_with("<!--") {
+            at = skip_past(start + 4, "-->");
+        } else if rest.starts_with("<![CDATA[") {
+            at = skip_past(start + 9, "]]>");
+        } else if rest.starts_with("<?") {
+            at = skip_past(start + 2, "?>");
+        } else if rest.starts_with("<!") {
+            at = skip_past(start + 2, ">");
+        } else if rest.starts_with("</") {
+            depth = depth.saturating_sub(1);
+            at = skip_past(start + 2, ">");
+        } else {
+            // A start tag: to its `>` or `/>`, past quoted attribute values.
+            let mut j = start + 1;
+            let mut empty = false;
+            while j < bytes.len() {
+                match bytes[j] {
+                    q @ (b'"' | b'\'') => {
+                        j = bytes[j + 1..]
+                            .iter()
+                            .position(|&b| b == q)
+                            .map_or(bytes.len(), |k| j + 1 + k + 1);
+                        continue;
+                    }
+                    b'>' => {
+                        empty = bytes[j - 1] == b'/';
+                        break;
+                    }
+                    _ => j += 1,
+                }
+            }
+            if !empty {
+                depth += 1;
+                if depth > limit {
+                    return Err(line_at(start));
+                }
+            }
+            at = (j + 1).min(bytes.len());
+        }
+    }
+    Ok(())
 }
 
 struct Mitsuba<'d, 'i> {

@@ -190,6 +190,10 @@ pub struct Imported {
     maps: Vec<(String, Arc<Image>)>,
     /// For each TOML line from which on an item came from a place in the imported files.
     origins: Vec<(usize, Location)>,
+    /// The files the TOML names outside its mesh folder (lens files, maps): the 0-based index
+    /// of the line that names each, its key, and the path as written (relative to the
+    /// imported file's folder, or absolute).
+    external: Vec<External>,
     /// What was approximated or left out, each naming file, line and directive.
     pub warnings: Vec<String>,
 }
@@ -201,7 +205,11 @@ impl Imported {
             .map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned());
         let mesh_dir = format!("{stem}-meshes");
         let base = source.parent().unwrap_or(Path::new(""));
-        let (toml, origins) = emit(&ir, &mesh_dir, base, source)?;
+        let Emitted {
+            toml,
+            origins,
+            external,
+        } = emit(&ir, &mesh_dir, base, source)?;
         Ok(Imported {
             source: source.to_path_buf(),
             toml,
@@ -209,6 +217,7 @@ impl Imported {
             meshes: ir.meshes,
             maps: ir.maps,
             origins,
+            external,
             warnings: ir.warnings,
         })
     }
@@ -324,28 +333,26 @@ impl Imported {
             &format!("file = \"{}/", self.mesh_dir),
             &format!("file = \"{mesh_dir}/"),
         );
-        if !same(src_base, out_base) {
-            // Maps named relative to the imported file: absolute in the copy.
+        if !same(src_base, out_base) && !self.external.is_empty() {
+            // Files named relative to the imported file (lens files, maps): absolute in the
+            // copy, which is read from another folder.
             let abs = std::path::absolute(src_base).map_err(|source| ImportError::Io {
                 file: src_base.to_path_buf(),
                 action: "cannot resolve the folder",
                 source,
             })?;
-            let mut out = String::new();
-            for line in text.lines() {
-                match line.strip_prefix("file = \"") {
-                    Some(rest) if !rest.starts_with(&format!("{mesh_dir}/")) => {
-                        let name = rest.trim_end_matches('"');
-                        let _ =
-                            writeln!(out, "file = {}", quote(&abs.join(name).to_string_lossy()));
-                    }
-                    _ => {
-                        out.push_str(line);
-                        out.push('\n');
-                    }
+            let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+            for e in &self.external {
+                if let Some(line) = lines.get_mut(e.line) {
+                    *line = format!(
+                        "{} = {}",
+                        e.key,
+                        quote(&abs.join(&e.path).to_string_lossy())
+                    );
                 }
             }
-            text = out;
+            text = lines.join("\n");
+            text.push('\n');
         }
         Ok(text)
     }
@@ -406,15 +413,47 @@ fn finite_matrix(m: &DMat4, loc: &Location, what: &str) -> Result<(), ImportErro
     }
 }
 
-/// The scene as TOML, and the TOML line from which on each item came from where.
-fn emit(
-    ir: &Ir,
-    mesh_dir: &str,
-    base: &Path,
-    source: &Path,
-) -> Result<(String, Vec<(usize, Location)>), ImportError> {
+/// A file the TOML names outside its mesh folder, which a copy written elsewhere must name by
+/// its absolute path.
+#[derive(Clone, Debug)]
+struct External {
+    /// The 0-based index of the TOML line `key = "path"`.
+    line: usize,
+    key: &'static str,
+    /// As written: relative to the imported file's folder, or absolute.
+    path: PathBuf,
+}
+
+/// What [`emit`] writes.
+struct Emitted {
+    /// The scene as TOML.
+    toml: String,
+    /// The TOML line from which on each item came from where.
+    origins: Vec<(usize, Location)>,
+    /// The files it names outside its mesh folder.
+    external: Vec<External>,
+}
+
+/// The scene as TOML, with where its parts came from and the files it names.
+fn emit(ir: &Ir, mesh_dir: &str, base: &Path, source: &Path) -> Result<Emitted, ImportError> {
     let mut out = String::new();
     let mut origins = Vec::new();
+    let mut external = Vec::new();
+    // Writes `key = "path"` for a file the import resolved against the imported file's folder
+    // (`path` as found from the working folder), relative to that folder, where the TOML's
+    // reader looks. Lines are counted on from the last call, as `line` does below.
+    let (mut file_counted, mut file_lines) = (0usize, 0usize);
+    let mut name_file = |out: &mut String, key: &'static str, path: &Path| {
+        file_lines += out[file_counted..].matches('\n').count();
+        file_counted = out.len();
+        let rel = path.strip_prefix(base).unwrap_or(path).to_path_buf();
+        let _ = writeln!(out, "{key} = {}", quote(&rel.to_string_lossy()));
+        external.push(External {
+            line: file_lines,
+            key,
+            path: rel,
+        });
+    };
     // The line the text has reached, counted on from the last call (emitting stays linear).
     let (mut counted, mut lines) = (0usize, 0usize);
     let mut line = |out: &String| {
@@ -516,7 +555,7 @@ fn emit(
         let _ = writeln!(out, "focal_distance = {}", num(f));
     }
     if let Some((file, aperture, focus, diagonal)) = &camera.realistic {
-        let _ = writeln!(out, "lens_file = {}", quote(&file.to_string_lossy()));
+        name_file(&mut out, "lens_file", file);
         let _ = writeln!(out, "aperture_diameter = {}", num(*aperture));
         let _ = writeln!(out, "focus_distance = {}", num(*focus));
         let _ = writeln!(out, "film_diagonal = {}", num(*diagonal));
@@ -625,10 +664,7 @@ fn emit(
             } => {
                 let _ = writeln!(out, "type = \"environment\"\nradiance = {}", v3(*radiance));
                 match file {
-                    Some(MapIr::File(f)) => {
-                        let rel = f.strip_prefix(base).unwrap_or(f);
-                        let _ = writeln!(out, "file = {}", quote(&rel.to_string_lossy()));
-                    }
+                    Some(MapIr::File(f)) => name_file(&mut out, "file", f),
                     Some(MapIr::Made(i)) => {
                         let name = ir.maps.get(*i).map_or("missing", |m| m.0.as_str());
                         let _ = writeln!(out, "file = {}", quote(&format!("{mesh_dir}/{name}")));
@@ -645,7 +681,11 @@ fn emit(
             }
         };
     }
-    Ok((out, origins))
+    Ok(Emitted {
+        toml: out,
+        origins,
+        external,
+    })
 }
 
 /// A mesh as OBJ text, every number written exactly (shortest round-trip form).

@@ -16,6 +16,7 @@ use crate::scene::{CameraIr, FilmIr, GeometryIr, Imported, Ir, LightIr, Material
 use glam::{DMat4, DVec3, Vec2, Vec3};
 use lexer::{Kind, Token};
 use obscura_accel::TriangleMesh;
+use obscura_space::{AnimatedTransform, Object, Transform, World};
 use params::{Param, Params, Value};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -81,7 +82,9 @@ struct Pbrt {
     named_materials: HashMap<String, Option<String>>,
     objects: HashMap<String, Vec<ShapeIr>>,
     object: Option<(String, Vec<ShapeIr>, Location)>,
+    /// `TransformTimes`: when the two CTMs hold, and where it was said (None: pbrt's 0 1).
     times: [f64; 2],
+    times_loc: Option<Location>,
     camera: Option<(String, Params, [DMat4; 2], Location)>,
     film: Option<(Params, Location)>,
     plys: HashMap<PathBuf, usize>,
@@ -301,6 +304,7 @@ impl Pbrt {
             objects: HashMap::new(),
             object: None,
             times: [0.0, 1.0],
+            times_loc: None,
             camera: None,
             film: None,
             plys: HashMap::new(),
@@ -409,10 +413,20 @@ impl Pbrt {
             }
             "TransformTimes" => {
                 let [a, b] = c.nums::<2>(d)?;
+                if self.world {
+                    // pbrt-v4 refuses it too: the times are an option, fixed before the world.
+                    return Err(loc.error(
+                        "TransformTimes: not allowed after WorldBegin (pbrt-v4 takes it only before)",
+                    ));
+                }
+                if !(a.is_finite() && b.is_finite()) {
+                    return Err(loc.error("TransformTimes: the times must be finite"));
+                }
                 if a > b {
                     return Err(loc.error("TransformTimes: start after end"));
                 }
                 self.times = [a, b];
+                self.times_loc = Some(loc);
             }
             "ActiveTransform" => {
                 let w = c.word(d)?;
@@ -1368,18 +1382,34 @@ impl Pbrt {
         if shutter[0] > shutter[1] {
             return Err(loc.error("Camera: shutteropen is after shutterclose"));
         }
-        let moving = ctm[0] != ctm[1] || self.ir.shapes.iter().any(|s| s.transform_end.is_some());
-        if moving && (self.times[0] != shutter[0] || self.times[1] != shutter[1]) {
-            self.ir.warn(&loc, format!(
-                "TransformTimes {} {} differ from the shutter {} {}: the end transforms are taken at shutter close",
-                self.times[0], self.times[1], shutter[0], shutter[1]
-            ));
+        // The scene format moves things from shutter open to close; pbrt from the start to the
+        // end transform time. Carry each motion over to the shutter's ends.
+        let over_shutter = |start: DMat4, end: DMat4, what: &Location, kind: &str| {
+            motion_over_shutter(start, end, self.times, shutter).map_err(|message| {
+                let [t0, t1] = self.times;
+                let (at, times) = match &self.times_loc {
+                    Some(at) => (at, format!("TransformTimes {t0} {t1}")),
+                    None => (&loc, format!("no TransformTimes (pbrt's {t0} {t1})")),
+                };
+                at.error(format!(
+                    "{times} with the shutter {} {} (Camera at {loc}): the {kind} at {what} {message}",
+                    shutter[0], shutter[1]
+                ))
+            })
+        };
+        let (pose, pose_end) = over_shutter(ctm[0].inverse(), ctm[1].inverse(), &loc, "camera")?;
+        let mut shapes = std::mem::take(&mut self.ir.shapes);
+        for s in &mut shapes {
+            if let Some(end) = s.transform_end {
+                (s.transform, s.transform_end) = over_shutter(s.transform, end, &s.loc, "shape")?;
+            }
         }
+        self.ir.shapes = shapes;
         let mut cam = CameraIr {
             loc: loc.clone(),
             kind: "perspective",
-            pose: ctm[0].inverse(),
-            pose_end: (ctm[1] != ctm[0]).then(|| ctm[1].inverse()),
+            pose,
+            pose_end,
             fov: None,
             fov_axis: None,
             screen_window: None,
@@ -1443,15 +1473,15 @@ impl Pbrt {
                 cam.pose_end = cam.pose_end.map(|m| m * p_from_obscura);
             }
             "realistic" => {
-                // pbrt-v4's parameters and defaults: lensfile (relative to the scene file),
-                // aperturediameter 1 mm, focusdistance 10; the film's diagonal (35 mm).
+                // pbrt-v4's parameters and defaults: lensfile (relative to the main scene
+                // file's folder, as pbrt resolves every file name), aperturediameter 1 mm,
+                // focusdistance 10; the film's diagonal (35 mm).
                 let Some(file) = p.string("lensfile")? else {
                     return Err(loc.error("Camera \"realistic\": \"string lensfile\" is required"));
                 };
-                let folder = loc.file.parent().unwrap_or(Path::new("."));
                 cam.kind = "realistic";
                 cam.realistic = Some((
-                    folder.join(file),
+                    self.resolve(&file),
                     p.num_or("aperturediameter", 1.0)? as f32,
                     p.num_or("focusdistance", 10.0)? as f32,
                     film_diagonal as f32,
@@ -1472,6 +1502,69 @@ impl Pbrt {
         self.ir.camera = Some(cam);
         Ok(())
     }
+}
+
+/// A motion given as pbrt gives it (`start` at transform time `times[0]`, `end` at `times[1]`)
+/// as the scene format takes it: the transforms at shutter open and close (None at close: no
+/// motion during the shutter). The error says why it cannot be carried over exactly.
+///
+/// pbrt-v4's `AnimatedTransform` decomposes each transform into translation, rotation (a
+/// quaternion, by polar decomposition) and stretch, and between the two times interpolates
+/// translation and stretch linearly and rotation by slerp the short way; before `times[0]` it
+/// holds `start`, after `times[1]` `end`. Obscura's `AnimatedTransform` interpolates the same
+/// way between the shutter's ends. Linear interpolation and slerp restricted to a
+/// sub-interval are the same functions of time over it, and a decomposition of an
+/// interpolated transform gives back its interpolated parts (a polar decomposition is unique,
+/// and a blend of two positive stretches is positive), so the transforms at the shutter's ends
+/// reproduce pbrt's motion exactly whenever the shutter lies within the transform times. A
+/// shutter reaching beyond them would see pbrt's motion stop part way, which two transforms
+/// cannot express. (Mirrored transforms, such as a camera after `Scale -1 1 1`, are the one
+/// difference already there with matching times: pbrt-v4 leaves a reflection in its polar
+/// factor unhandled, Obscura moves it into the stretch; the carrying over keeps Obscura's.)
+fn motion_over_shutter(
+    start: DMat4,
+    end: DMat4,
+    times: [f64; 2],
+    shutter: [f64; 2],
+) -> Result<(DMat4, Option<DMat4>), String> {
+    let ([t0, t1], [open, close]) = (times, shutter);
+    if start == end {
+        return Ok((start, None));
+    }
+    if times == shutter {
+        return Ok((start, Some(end)));
+    }
+    // A shutter wholly before or after the transform times sees one transform, held.
+    if close <= t0 {
+        return Ok((start, None));
+    }
+    if open >= t1 {
+        return Ok((end, None));
+    }
+    if open < t0 || close > t1 {
+        return Err(format!(
+            "moves only from {t0} to {t1}, held still for the rest of the shutter in pbrt, which \
+             Obscura's motion (from shutter open to close) cannot express; give the transforms \
+             at the shutter's times (TransformTimes {open} {close})"
+        ));
+    }
+    // Here t0 < t1 (t0 = t1 would have the shutter wholly before or after them).
+    let key = |m: DMat4| {
+        Transform::<World, Object>::from_matrix(m.as_mat4())
+            .map_err(|e| format!("cannot be interpolated: {e}"))
+    };
+    let motion = AnimatedTransform::new(key(start)?, t0 as f32, key(end)?, t1 as f32)
+        .map_err(|e| format!("cannot be interpolated: {e}"))?;
+    let at = |time: f64| match time {
+        t if t == t0 => start,
+        t if t == t1 => end,
+        t => motion.at(t as f32).matrix().as_dmat4(),
+    };
+    Ok(if open == close {
+        (at(open), None)
+    } else {
+        (at(open), Some(at(close)))
+    })
 }
 
 /// The surface swept by turning the polyline `profile` of (radius, z) points about +z by

@@ -511,3 +511,34 @@ fn max_depth_counts_the_emitter_vertex_as_mitsuba_does() {
     assert!(e.to_string().contains("max_depth 1"), "{e}");
     assert_eq!(line_of(&e), Some(1));
 }
+
+#[test]
+fn deep_nesting_is_an_error_at_its_line_not_a_stack_overflow() {
+    // `<scene>` holding `n` nested shapes, one element per line: the root is level 1 on line
+    // 1, the sensor line 2, and the k-th nested shape (level k + 1) is on line k + 2. Attribute
+    // values, a comment and a CDATA section hold tag-like text that must not count.
+    let nested = |n: usize| {
+        let mut s = String::from("<scene version=\"3.0.0\">\n<sensor type=\"perspective\"/>\n");
+        for _ in 0..n {
+            s.push_str("<shape type=\"sphere\" id='a>b/>'><!-- <x> --><![CDATA[<y>]]>\n");
+        }
+        for _ in 0..n {
+            s.push_str("</shape>");
+        }
+        s + "</scene>\n"
+    };
+    // 255 nested shapes reach level 256, the limit: imported.
+    import(&nested(255)).description().unwrap();
+    // One more is refused at the 256th shape's line; far more (enough to overflow the stack
+    // of the recursive XML parser) fails the same way, as the CLI's exit status 2.
+    for n in [256, 200_000] {
+        let e =
+            parse_mitsuba(Path::new("/nonexistent/deep.xml"), &nested(n)).expect_err("too deep");
+        assert_eq!(line_of(&e), Some(258), "{e}");
+        assert!(
+            e.to_string()
+                .starts_with("/nonexistent/deep.xml:258: elements nested more than 256"),
+            "{e}"
+        );
+    }
+}

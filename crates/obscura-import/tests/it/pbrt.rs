@@ -875,3 +875,215 @@ fn the_realistic_camera_takes_pbrts_parameters_and_defaults() {
     let e = import_err("Camera \"realistic\"\nWorldBegin");
     assert!(e.to_string().contains("lensfile"), "{e}");
 }
+
+/// `path` (absolute) as a path relative to the working folder, as a user in another folder
+/// would type it.
+fn relative_to_cwd(path: &Path) -> std::path::PathBuf {
+    let cwd = std::env::current_dir().unwrap().canonicalize().unwrap();
+    let path = path.canonicalize().unwrap();
+    let mut rel = std::path::PathBuf::new();
+    let common = cwd
+        .components()
+        .zip(path.components())
+        .take_while(|(a, b)| a == b)
+        .count();
+    for _ in common..cwd.components().count() {
+        rel.push("..");
+    }
+    rel.extend(path.components().skip(common));
+    rel
+}
+
+#[test]
+fn the_lens_file_is_found_from_any_working_folder_and_after_convert() {
+    // pbrt-v4 resolves `lensfile` (like every file name) against the folder of the main scene
+    // file, whatever the working folder and whichever file the Camera is in. The files go
+    // under the target folder, so the relative path from the working folder (the crate's) does
+    // not climb to the root, where a doubled prefix (`a/../a/b`) would still find them.
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("obscura-import-{}-lens-folder", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let lens = include_str!("../../../../scenes/lenses/double-gauss-50mm.dat");
+    std::fs::create_dir_all(dir.join("scene/lenses")).unwrap();
+    std::fs::create_dir_all(dir.join("scene/parts")).unwrap();
+    write(&dir.join("scene/lenses"), "dgauss.dat", lens);
+    let camera = "LookAt 0 0 5  0 0 0  0 1 0\n\
+                  Camera \"realistic\" \"string lensfile\" \"lenses/dgauss.dat\" \
+                  \"float aperturediameter\" 5 \"float focusdistance\" 5\n\
+                  Film \"rgb\" \"integer xresolution\" 16 \"integer yresolution\" 8\n";
+    let direct = write(
+        &dir.join("scene"),
+        "real.pbrt",
+        &format!("{camera}WorldBegin\nShape \"sphere\"\n"),
+    );
+    write(&dir.join("scene/parts"), "camera.pbrt", camera);
+    let included = write(
+        &dir.join("scene"),
+        "included.pbrt",
+        "Include \"parts/camera.pbrt\"\nWorldBegin\nShape \"sphere\"\n",
+    );
+    let want = dir.join("scene/lenses/dgauss.dat").canonicalize().unwrap();
+    for scene in [&direct, &included] {
+        // Named from the working folder by a relative path that does not start at the scene.
+        let relative = relative_to_cwd(scene);
+        let cwd_depth = std::env::current_dir().unwrap().components().count();
+        let ups = relative
+            .components()
+            .filter(|c| *c == std::path::Component::ParentDir)
+            .count();
+        assert!(ups + 1 < cwd_depth, "{}", relative.display());
+        let imported = obscura_import::import(&relative).unwrap();
+        let d = imported.description().expect("the lens file is found");
+        let found = &d.camera.realistic.as_ref().unwrap().lens_file;
+        assert_eq!(found.canonicalize().unwrap(), want, "{}", scene.display());
+        camera_of(&d).expect("the lens system builds");
+
+        // Converted into another folder, the TOML names the lens file so that it is found
+        // from there; converted beside the scene, it keeps the relative name.
+        let elsewhere = dir.join("out/sub/real.toml");
+        std::fs::create_dir_all(elsewhere.parent().unwrap()).unwrap();
+        imported
+            .write(&relative_to_cwd(&dir.join("out/sub")).join("real.toml"))
+            .unwrap();
+        let d = obscura_render::load_description(&elsewhere).expect("the copy loads");
+        let found = &d.camera.realistic.as_ref().unwrap().lens_file;
+        assert_eq!(found.canonicalize().unwrap(), want);
+        let beside = dir.join("scene/beside.toml");
+        imported.write(&beside).unwrap();
+        let text = std::fs::read_to_string(&beside).unwrap();
+        assert!(text.contains("lens_file = \"lenses/dgauss.dat\""), "{text}");
+        obscura_render::load_description(&beside).expect("the copy beside loads");
+    }
+}
+
+/// The world position of object point `p` under a shape's transform.
+fn placed(t: &obscura_space::Transform<World, obscura_space::Object>, p: [f32; 3]) -> glam::Vec3 {
+    t.matrix().transform_point3(glam::Vec3::from(p))
+}
+
+fn assert_near(got: glam::Vec3, want: [f64; 3], what: &str) {
+    let want = glam::DVec3::from(want).as_vec3();
+    assert!(
+        (got - want).length() < 1e-5,
+        "{what}: {got:?}, want {want:?}"
+    );
+}
+
+#[test]
+fn transform_times_place_the_motion_on_the_shutter_as_pbrt_does() {
+    // pbrt-v4's AnimatedTransform: the transform at time t is the start and end transforms'
+    // decompositions (translation T, rotation quaternion R, stretch S) blended at
+    // u = (t - t0) / (t1 - t0): T and S linearly, R by slerp. Here t0 = 0, t1 = 2 and the
+    // shutter is [0, 1], so at shutter close u = 1/2:
+    // - the camera's eye moves from (0, 0, 5) to (2, 0, 5) without turning: (1, 0, 5);
+    // - the sphere goes from the identity to T(0, 2, 0) R_z(90) S(3): T = (0, 1, 0),
+    //   R = R_z(45), S = 2, so object point (1, 0, 0) is at (2 cos 45, 1 + 2 sin 45, 0).
+    // At t = 0.5 (u = 1/4): T = (0, 0.5, 0), R = R_z(22.5), S = 1.5.
+    let text = "TransformTimes 0 2\n\
+                ActiveTransform StartTime\nLookAt 0 0 5  0 0 0  0 1 0\n\
+                ActiveTransform EndTime\nLookAt 2 0 5  2 0 0  0 1 0\n\
+                ActiveTransform All\n\
+                Camera \"perspective\" \"float shutteropen\" 0 \"float shutterclose\" 1\n\
+                WorldBegin\nAttributeBegin\nActiveTransform EndTime\n\
+                Translate 0 2 0\nRotate 90 0 0 1\nScale 3 3 3\nActiveTransform All\n\
+                Shape \"sphere\"\nAttributeEnd\n";
+    let d = import(text).description().unwrap();
+    let (pose, pose_end) = d.camera.pose.unwrap();
+    let eye = |t: &obscura_space::Transform<World, obscura_space::Camera>| {
+        t.matrix().transform_point3(glam::Vec3::ZERO)
+    };
+    assert_near(eye(&pose), [0.0, 0.0, 5.0], "eye at shutter open");
+    assert_near(
+        eye(&pose_end.unwrap()),
+        [1.0, 0.0, 5.0],
+        "eye at shutter close",
+    );
+    let s = &d.shapes[0];
+    let end = s.transform_end.expect("the sphere moves");
+    assert_near(
+        placed(&s.transform, [1.0, 0.0, 0.0]),
+        [1.0, 0.0, 0.0],
+        "open",
+    );
+    let h = std::f64::consts::FRAC_1_SQRT_2;
+    assert_near(
+        placed(&end, [1.0, 0.0, 0.0]),
+        [2.0 * h, 1.0 + 2.0 * h, 0.0],
+        "close",
+    );
+    // In between, the renderer's motion from open to close is pbrt's.
+    let motion = obscura_space::AnimatedTransform::new(s.transform, 0.0, end, 1.0).unwrap();
+    let (c, sn) = (22.5f64.to_radians().cos(), 22.5f64.to_radians().sin());
+    assert_near(
+        placed(&motion.at(0.5), [1.0, 0.0, 0.0]),
+        [1.5 * c, 0.5 + 1.5 * sn, 0.0],
+        "t = 0.5",
+    );
+
+    // A shutter inside the transform times: TransformTimes 0 4, shutter [1, 3], a move from
+    // x = 0 to x = 4 is at x = 1 at open and x = 3 at close.
+    let d = import(
+        "TransformTimes 0 4\nCamera \"perspective\" \"float shutteropen\" 1 \"float shutterclose\" 3\n\
+         WorldBegin\nActiveTransform EndTime\nTranslate 4 0 0\nActiveTransform All\nShape \"sphere\"\n",
+    )
+    .description()
+    .unwrap();
+    let s = &d.shapes[0];
+    assert_near(placed(&s.transform, [0.0; 3]), [1.0, 0.0, 0.0], "open");
+    assert_near(
+        placed(&s.transform_end.unwrap(), [0.0; 3]),
+        [3.0, 0.0, 0.0],
+        "close",
+    );
+
+    // A shutter wholly after the transform times sees pbrt's end transform, held: no motion.
+    let d = import(
+        "TransformTimes 0 0.5\nCamera \"perspective\" \"float shutteropen\" 1 \"float shutterclose\" 2\n\
+         WorldBegin\nActiveTransform EndTime\nTranslate 4 0 0\nActiveTransform All\nShape \"sphere\"\n",
+    )
+    .description()
+    .unwrap();
+    assert!(d.shapes[0].transform_end.is_none());
+    assert_near(
+        placed(&d.shapes[0].transform, [0.0; 3]),
+        [4.0, 0.0, 0.0],
+        "held",
+    );
+}
+
+#[test]
+fn a_shutter_beyond_the_transform_times_is_an_error_naming_transform_times() {
+    // pbrt holds the end transform after t1 = 0.5, so over the shutter [0, 1] the camera (or
+    // the sphere) moves, then stops: two transforms at shutter open and close cannot say that.
+    for (what, text) in [
+        (
+            "camera",
+            "LookAt 0 0 5  0 0 0  0 1 0\nTransformTimes 0 0.5\nActiveTransform EndTime\n\
+             Translate 1 0 0\nActiveTransform All\nCamera \"perspective\"\nWorldBegin\n\
+             Shape \"sphere\"\n",
+        ),
+        (
+            "shape",
+            "LookAt 0 0 5  0 0 0  0 1 0\nTransformTimes 0 0.5\nCamera \"perspective\"\n\
+             WorldBegin\nActiveTransform EndTime\nTranslate 1 0 0\nActiveTransform All\n\
+             Shape \"sphere\"\n",
+        ),
+    ] {
+        let e = import_err(text);
+        assert_eq!(line_of(&e), Some(2), "{what}: {e}");
+        let message = e.to_string();
+        assert!(
+            message.contains("test.pbrt:2") && message.contains("TransformTimes"),
+            "{what}: {message}"
+        );
+        assert!(message.contains(what), "{what}: {message}");
+    }
+    // Nothing moves: the times do not matter.
+    import("TransformTimes 0 0.5\nCamera \"perspective\"\nWorldBegin\nShape \"sphere\"\n")
+        .description()
+        .unwrap();
+    // pbrt-v4 takes TransformTimes only before WorldBegin.
+    let e = import_err("Camera \"perspective\"\nWorldBegin\nTransformTimes 0 2\n");
+    assert_eq!(line_of(&e), Some(3), "{e}");
+    assert!(e.to_string().contains("WorldBegin"), "{e}");
+}
