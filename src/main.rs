@@ -6,7 +6,7 @@ use obscura_import::Imported;
 use obscura_render::{
     CameraKind, Checkpoint, Film, ImageInfo, IntegratorKind, OutputFormat, Partial, RenderError,
     RenderOptions, RenderScene, SceneDescription, Slice, SliceBy, StereoLayout, compose_stereo,
-    load_description, merge_partials, render, scene_fingerprint, write_image,
+    merge_partials, render, scene_fingerprint, write_image,
 };
 use signal_hook::consts::{SIGINT, SIGTERM};
 use std::io::IsTerminal;
@@ -840,14 +840,11 @@ fn report_skipped(scene: &RenderScene) {
 /// Reads a scene: TOML as it is, a .pbrt or .xml through obscura-import (whose warnings go to
 /// stderr); the import is kept to place later errors on its lines.
 fn load_scene(path: &Path) -> Result<(SceneDescription, Option<Imported>), RenderError> {
-    if !obscura_import::is_importable(path) {
-        return Ok((load_description(path)?, None));
-    }
-    let imported = obscura_import::import(path)?;
-    for w in &imported.warnings {
+    let (description, imported) = obscura_import::load(path)?;
+    for w in imported.iter().flat_map(|i| &i.warnings) {
         eprintln!("warning: {w}");
     }
-    Ok((imported.description()?, Some(imported)))
+    Ok((description, imported))
 }
 
 /// A renderer error moved onto the imported file's line, for imported scenes.

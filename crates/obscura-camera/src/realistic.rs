@@ -581,8 +581,8 @@ impl RealisticCamera {
     /// along it projects back to the film point: the ray to use for one ray per film point.
     pub fn generate_chief_ray(&self, sample: &CameraSample) -> Option<Ray<World>> {
         let time = crate::camera::ray_time(&self.base, sample)?;
-        let out = self.chief_ray_lens(self.film_point(sample.p_film))?;
-        let parts = CameraRayParts::by_distance(out.o / MM_PER_UNIT, out.d, &self.base);
+        let (o, d) = self.chief_ray(sample.p_film)?;
+        let parts = CameraRayParts::by_distance(o, d, &self.base);
         let world_from_camera = self.pose.world_from_camera(&self.base, time);
         Some(chain::to_world(&world_from_camera, parts, time))
     }

@@ -58,6 +58,19 @@ pub fn is_importable(path: &Path) -> bool {
     )
 }
 
+/// Reads any scene file the renderer takes: the scene format's TOML as it is, a `.pbrt` or
+/// `.xml` through [`import`]. The [`Imported`] scene, when there is one, holds the import's
+/// warnings for the caller to show and [`Imported::locate`] for the renderer's later errors.
+pub fn load(
+    path: &Path,
+) -> Result<(obscura_render::SceneDescription, Option<Imported>), obscura_render::RenderError> {
+    if !is_importable(path) {
+        return Ok((obscura_render::load_description(path)?, None));
+    }
+    let imported = import(path)?;
+    Ok((imported.description()?, Some(imported)))
+}
+
 /// Imports a pbrt-v4 (`.pbrt`) or Mitsuba 3 (`.xml`) scene, by the file's extension.
 pub fn import(path: &Path) -> Result<Imported, ImportError> {
     match path

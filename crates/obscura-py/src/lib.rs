@@ -963,15 +963,14 @@ fn load_scene(py: Python<'_>, path: PathBuf) -> PyResult<PyScene> {
 /// through obscura-import (errors moved to the imported file's lines), with the import's
 /// warnings.
 fn build_scene(path: &Path) -> PyResult<(RenderScene, Vec<String>)> {
-    if !obscura_import::is_importable(path) {
-        let d = load_description(path).map_err(render_err)?;
-        return Ok((RenderScene::build(d).map_err(render_err)?, Vec::new()));
+    let (d, imported) = obscura_import::load(path).map_err(render_err)?;
+    match imported {
+        None => Ok((RenderScene::build(d).map_err(render_err)?, Vec::new())),
+        Some(i) => {
+            let scene = RenderScene::build(d).map_err(|e| render_err(i.locate(e)))?;
+            Ok((scene, i.warnings))
+        }
     }
-    let import_err = |e: obscura_import::ImportError| PyValueError::new_err(e.to_string());
-    let imported = obscura_import::import(path).map_err(import_err)?;
-    let d = imported.description().map_err(import_err)?;
-    let scene = RenderScene::build(d).map_err(|e| render_err(imported.locate(e)))?;
-    Ok((scene, imported.warnings))
 }
 
 /// What a render's waiting thread does between polls: report progress, check Ctrl-C.
