@@ -16,8 +16,6 @@
 //! crash of the interpreter.
 #![deny(missing_docs)]
 
-mod camera_file;
-
 use numpy::{
     IntoPyArray, PyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2, PyReadonlyArrayDyn,
     PyUntypedArrayMethods,
@@ -28,8 +26,9 @@ use obscura_camera::{
     OpenCvFisheyeCamera, OpenCvIntrinsics, Shutter, opencv_pose,
 };
 use obscura_render::{
-    CameraKind, IntegratorKind, RenderError, RenderOptions, RenderScene, SceneDescription,
-    camera_of, compose_stereo, load_description, parse_description, read_exr,
+    CameraDescription, CameraKind, IntegratorKind, RenderError, RenderOptions, RenderScene,
+    SceneDescription, camera_of, compose_stereo, load_camera_description, parse_camera_description,
+    read_exr,
 };
 use obscura_sample::{Sampler, SamplerKind};
 use obscura_space::{Point2, Point3, Ray, World};
@@ -398,24 +397,21 @@ pub struct PyCamera {
 /// The scene format's default sampler (`[sampler] type` absent).
 const DEFAULT_SAMPLER: SamplerKind = SamplerKind::Sobol;
 
-/// The camera's part ([`camera_file`]) of a scene file given by path or as TOML text: an
-/// `os.PathLike`, or a one-line `str` that names an existing file or has no `=` (so cannot be a
-/// scene), is read as a file; any other `str` is parsed as the text of a scene file (errors
-/// then name `<string>`).
-fn camera_description(obj: &Bound<'_, PyAny>) -> PyResult<SceneDescription> {
-    let (path, text) = if let Ok(text) = obj.extract::<String>() {
+/// The camera's part ([`parse_camera_description`]) of a scene file given by path or as TOML
+/// text: an `os.PathLike`, or a one-line `str` that names an existing file or has no `=` (so
+/// cannot be a scene), is read as a file; any other `str` is parsed as the text of a scene file
+/// (errors then name `<string>`).
+fn camera_description(obj: &Bound<'_, PyAny>) -> PyResult<CameraDescription> {
+    let description = if let Ok(text) = obj.extract::<String>() {
         let as_path = Path::new(&text);
         if !text.contains('\n') && (as_path.is_file() || !text.contains('=')) {
-            (as_path.to_path_buf(), scene_file_text(as_path)?)
+            load_camera_description(as_path)
         } else {
-            (PathBuf::from("<string>"), text)
+            parse_camera_description(Path::new("<string>"), &text)
         }
     } else {
         match obj.extract::<PathBuf>() {
-            Ok(path) => {
-                let text = scene_file_text(&path)?;
-                (path, text)
-            }
+            Ok(path) => load_camera_description(&path),
             Err(_) => {
                 return Err(PyTypeError::new_err(format!(
                     "expected TOML text, a path string or an os.PathLike, got {}",
@@ -424,24 +420,7 @@ fn camera_description(obj: &Bound<'_, PyAny>) -> PyResult<SceneDescription> {
             }
         }
     };
-    let camera_text = camera_file::camera_tables(&text);
-    parse_description(&path, camera_text.as_deref().unwrap_or(&text)).map_err(render_err)
-}
-
-/// The text of a scene file, refused as the renderer refuses it (unreadable, or not UTF-8).
-fn scene_file_text(path: &Path) -> PyResult<String> {
-    let bytes = std::fs::read(path).map_err(|source| {
-        render_err(RenderError::Io {
-            file: path.to_path_buf(),
-            action: "cannot read the scene file",
-            source,
-        })
-    })?;
-    // The renderer's reader names the line of the first byte that is not UTF-8.
-    String::from_utf8(bytes).map_err(|_| match load_description(path) {
-        Err(e) => render_err(e),
-        Ok(_) => PyValueError::new_err(format!("{}: the file is not UTF-8 text", path.display())),
-    })
+    description.map_err(render_err)
 }
 
 /// The film of an OpenCV calibration: `size` is (width, height).
@@ -509,10 +488,10 @@ impl PyCamera {
     #[staticmethod]
     fn from_toml(text_or_path: &Bound<'_, PyAny>) -> PyResult<PyCamera> {
         let d = camera_description(text_or_path)?;
-        let camera = camera_of(&d).map_err(render_err)?;
+        let camera = d.camera().map_err(render_err)?;
         Ok(PyCamera {
             camera: Box::new(camera),
-            sampler: d.sampler.kind,
+            sampler: d.sampler,
         })
     }
 

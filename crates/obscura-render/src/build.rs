@@ -4,8 +4,8 @@
 use crate::error::RenderError;
 use crate::film::{Filter, PixelRect};
 use crate::scene::{
-    CameraKind, CameraSettings, IntegratorKind, LightSettings, MaterialSettings, SceneDescription,
-    ShapeGeometry,
+    CameraDescription, CameraKind, CameraSettings, IntegratorKind, LightSettings, MaterialSettings,
+    SceneDescription, ShapeGeometry,
 };
 use crate::scene::{DEFAULT_INTERAXIAL, camera_key};
 use glam::Vec3;
@@ -280,6 +280,16 @@ fn material(m: MaterialSettings) -> Material {
 pub fn camera_of(d: &SceneDescription) -> Result<AnyCamera, RenderError> {
     build_camera(&d.camera, d.film.resolution, d.film.crop)
         .map_err(|e| d.error(camera_key(&e), e.to_string()))
+}
+
+impl CameraDescription {
+    /// The camera, with the errors [`camera_of`] gives (naming the file, the `camera.*` or
+    /// `film.*` key and the line).
+    pub fn camera(&self) -> Result<AnyCamera, RenderError> {
+        build_camera(&self.camera, self.film.resolution, self.film.crop).map_err(|e| {
+            RenderError::at_key(&self.file, &self.source, camera_key(&e), e.to_string())
+        })
+    }
 }
 
 pub(crate) fn build_camera(

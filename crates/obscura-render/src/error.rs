@@ -1,6 +1,6 @@
 //! The renderer's one error type.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Why a scene could not be loaded or rendered, or an image not written.
 ///
@@ -65,13 +65,21 @@ pub enum RenderError {
     },
 }
 
+impl RenderError {
+    /// A scene error at `key` (a path such as `camera.fov`), with the key's line found in the
+    /// file's `source` text.
+    pub(crate) fn at_key(file: &Path, source: &str, key: &str, message: impl Into<String>) -> Self {
+        RenderError::Scene {
+            file: file.to_path_buf(),
+            line: crate::locate::line_of_key(source, key),
+            key: Some(key.to_string()),
+            message: message.into(),
+        }
+    }
+}
+
 /// `file[:line][: key]: message`, the one-line form of a scene error.
-fn located(
-    file: &std::path::Path,
-    line: Option<usize>,
-    key: Option<&str>,
-    message: &str,
-) -> String {
+fn located(file: &Path, line: Option<usize>, key: Option<&str>, message: &str) -> String {
     let mut out = file.display().to_string();
     if let Some(line) = line {
         out += &format!(":{line}");

@@ -3,7 +3,8 @@
 //!
 //! - [`load_description`] / [`parse_description`] read a TOML scene file strictly into a
 //!   [`SceneDescription`] (unknown keys, NaNs and out-of-range values are [`RenderError`]s that
-//!   name the file, the key and the line);
+//!   name the file, the key and the line); [`parse_camera_description`] reads only the
+//!   camera's part of one into a [`CameraDescription`], skipping the scene it looks at;
 //! - [`RenderScene::build`] turns it into a camera (`obscura-camera`), geometry
 //!   (`obscura-accel`), materials and lights (`obscura-shade`) and a sampler;
 //! - [`render`] takes the samples in passes of one per pixel over 16x16 tiles, in parallel,
@@ -82,9 +83,10 @@ pub use render::{
     RenderOptions, RenderOutcome, RenderStats, TILE_SIZE, TILE_WINDOW, render, sample_value, tiles,
 };
 pub use scene::{
-    CameraKind, CameraPose, CameraSettings, DEFAULT_FOCUS_DISTANCE, DEFAULT_INTERAXIAL, Extrinsics,
-    FilmSettings, FilterSettings, IntegratorKind, IntegratorSettings, LightSettings,
-    MaterialSettings, RealisticSettings, SamplerSettings, SceneDescription, ShapeGeometry,
-    ShapeSettings, StereoLayout, StereoSettings, load_description, parse_description,
+    CameraDescription, CameraKind, CameraPose, CameraSettings, DEFAULT_FOCUS_DISTANCE,
+    DEFAULT_INTERAXIAL, Extrinsics, FilmSettings, FilterSettings, IntegratorKind,
+    IntegratorSettings, LightSettings, MaterialSettings, RealisticSettings, SamplerSettings,
+    SceneDescription, ShapeGeometry, ShapeSettings, StereoLayout, StereoSettings,
+    load_camera_description, load_description, parse_camera_description, parse_description,
 };
 pub use stereo::compose_stereo;

@@ -2,45 +2,25 @@
 //! the file, the key and the line.
 
 use super::raw::{
-    RawFilm, RawIntegrator, RawLight, RawMaterial, RawOp, RawSampler, RawScene, RawShape,
+    RawCamera, RawCameraPart, RawFilm, RawIntegrator, RawLight, RawMaterial, RawOp, RawSampler,
+    RawScene, RawShape,
 };
 use super::settings::*;
 use crate::error::RenderError;
-use crate::locate::{key_at_line, line_of_key, line_of_offset};
+use crate::locate::{key_at_line, line_of_offset};
 use obscura_sample::SamplerKind;
 use obscura_space::{SpaceError, Transform, World};
+use serde::de::DeserializeOwned;
 use std::path::Path;
 
 /// Reads and validates a scene file.
 pub fn load_description(path: &Path) -> Result<SceneDescription, RenderError> {
-    let source = std::fs::read(path).map_err(|source| RenderError::Io {
-        file: path.to_path_buf(),
-        action: "cannot read the scene file",
-        source,
-    })?;
-    let source = String::from_utf8(source).map_err(|e| RenderError::Scene {
-        file: path.to_path_buf(),
-        line: Some(line_of_offset(
-            &String::from_utf8_lossy(e.as_bytes()),
-            e.utf8_error().valid_up_to(),
-        )),
-        key: None,
-        message: "the file is not UTF-8 text".into(),
-    })?;
-    parse_description(path, &source)
+    parse_description(path, &read_scene(path)?)
 }
 
 /// Validates scene-file text; `path` names the file in messages and anchors relative paths.
 pub fn parse_description(path: &Path, source: &str) -> Result<SceneDescription, RenderError> {
-    let raw: RawScene = toml::from_str(source).map_err(|e| {
-        let line = e.span().map(|s| line_of_offset(source, s.start));
-        RenderError::Scene {
-            file: path.to_path_buf(),
-            line,
-            key: line.and_then(|l| key_at_line(source, l)),
-            message: e.message().trim().to_string(),
-        }
-    })?;
+    let raw: RawScene = from_toml(path, source)?;
     let cx = Cx { file: path, source };
     let base = path.parent().unwrap_or(Path::new(""));
     let mut ignored = Vec::new();
@@ -48,11 +28,7 @@ pub fn parse_description(path: &Path, source: &str) -> Result<SceneDescription, 
     let film = cx.film(raw.film)?;
     let sampler = cx.sampler(raw.sampler)?;
     let integrator = cx.integrator(raw.integrator)?;
-    let camera = cx.camera(raw.camera, base, &mut ignored)?;
-    // What needs the film too (a fisheye's field of view, a square film) is checked by
-    // building the camera once.
-    crate::build::build_camera(&camera, film.resolution, film.crop)
-        .map_err(|e| cx.camera_err(e))?;
+    let camera = cx.checked_camera(raw.camera, &film, base, &mut ignored)?;
     let mut materials = Vec::new();
     for (name, m) in raw.materials {
         let m = cx.material(&name, m)?;
@@ -86,6 +62,74 @@ pub fn parse_description(path: &Path, source: &str) -> Result<SceneDescription, 
     })
 }
 
+/// Reads and validates the camera's part of a scene file, as
+/// [`parse_camera_description`] does.
+pub fn load_camera_description(path: &Path) -> Result<CameraDescription, RenderError> {
+    parse_camera_description(path, &read_scene(path)?)
+}
+
+/// Validates the camera's part of scene-file text: `[camera]` (with its sub-tables) and
+/// `[film]` as [`parse_description`] checks them, and of `[sampler]` only `type`. Every other
+/// table and key is skipped unchecked, so a scene whose shapes, materials, lights or integrator
+/// the renderer refuses still gives its camera; but the whole text must be TOML, and errors
+/// name the file's own lines. `path` names the file in messages and anchors relative paths
+/// (a lens file, an aperture image).
+pub fn parse_camera_description(
+    path: &Path,
+    source: &str,
+) -> Result<CameraDescription, RenderError> {
+    let raw: RawCameraPart = from_toml(path, source)?;
+    let cx = Cx { file: path, source };
+    let base = path.parent().unwrap_or(Path::new(""));
+    let mut ignored = Vec::new();
+
+    // The checks of `parse_description`, in its order, less those of the skipped keys.
+    let film = cx.film(raw.film)?;
+    let sampler = cx.sampler_kind(raw.sampler.kind.as_deref())?;
+    let camera = cx.checked_camera(raw.camera, &film, base, &mut ignored)?;
+    Ok(CameraDescription {
+        file: path.to_path_buf(),
+        film,
+        sampler,
+        camera,
+        ignored,
+        source: source.into(),
+    })
+}
+
+/// The text of a scene file: unreadable and non-UTF-8 files are errors, the latter with the
+/// line of the first bad byte.
+fn read_scene(path: &Path) -> Result<String, RenderError> {
+    let source = std::fs::read(path).map_err(|source| RenderError::Io {
+        file: path.to_path_buf(),
+        action: "cannot read the scene file",
+        source,
+    })?;
+    String::from_utf8(source).map_err(|e| RenderError::Scene {
+        file: path.to_path_buf(),
+        line: Some(line_of_offset(
+            &String::from_utf8_lossy(e.as_bytes()),
+            e.utf8_error().valid_up_to(),
+        )),
+        key: None,
+        message: "the file is not UTF-8 text".into(),
+    })
+}
+
+/// Deserializes scene-file text into raw structs: a syntax error anywhere, an unknown key or a
+/// value of the wrong type is an error at the line serde's span points to.
+fn from_toml<T: DeserializeOwned>(path: &Path, source: &str) -> Result<T, RenderError> {
+    toml::from_str(source).map_err(|e| {
+        let line = e.span().map(|s| line_of_offset(source, s.start));
+        RenderError::Scene {
+            file: path.to_path_buf(),
+            line,
+            key: line.and_then(|l| key_at_line(source, l)),
+            message: e.message().trim().to_string(),
+        }
+    })
+}
+
 /// The file and its text, for errors that find their own line.
 pub(super) struct Cx<'a> {
     pub(super) file: &'a Path,
@@ -94,12 +138,22 @@ pub(super) struct Cx<'a> {
 
 impl Cx<'_> {
     pub(super) fn err(&self, key: &str, message: impl Into<String>) -> RenderError {
-        RenderError::Scene {
-            file: self.file.to_path_buf(),
-            line: line_of_key(self.source, key),
-            key: Some(key.to_string()),
-            message: message.into(),
-        }
+        RenderError::at_key(self.file, self.source, key, message)
+    }
+
+    /// `[camera]` validated, then built once with the film: what needs the film too (a
+    /// fisheye's field of view, a square film) is checked by the camera crate's constructors.
+    fn checked_camera(
+        &self,
+        raw: RawCamera,
+        film: &FilmSettings,
+        base: &Path,
+        ignored: &mut Vec<String>,
+    ) -> Result<CameraSettings, RenderError> {
+        let camera = self.camera(raw, base, ignored)?;
+        crate::build::build_camera(&camera, film.resolution, film.crop)
+            .map_err(|e| self.camera_err(e))?;
+        Ok(camera)
     }
 
     pub(super) fn finite(&self, key: &str, v: &[f32]) -> Result<(), RenderError> {
@@ -236,15 +290,7 @@ impl Cx<'_> {
     }
 
     fn sampler(&self, s: RawSampler) -> Result<SamplerSettings, RenderError> {
-        let kind = match s.kind.as_deref() {
-            None => SamplerKind::Sobol,
-            Some(name) => name.parse().map_err(|_| {
-                self.err(
-                    "sampler.type",
-                    format!("unknown sampler `{name}`, expected independent, stratified, halton or sobol"),
-                )
-            })?,
-        };
+        let kind = self.sampler_kind(s.kind.as_deref())?;
         let spp = s.spp.unwrap_or(16);
         if spp == 0 {
             return Err(self.err("sampler.spp", "must be >= 1, got 0"));
@@ -254,6 +300,19 @@ impl Cx<'_> {
             spp,
             seed: s.seed.unwrap_or(0),
         })
+    }
+
+    /// `[sampler] type`; Sobol when absent.
+    fn sampler_kind(&self, name: Option<&str>) -> Result<SamplerKind, RenderError> {
+        match name {
+            None => Ok(SamplerKind::Sobol),
+            Some(name) => name.parse().map_err(|_| {
+                self.err(
+                    "sampler.type",
+                    format!("unknown sampler `{name}`, expected independent, stratified, halton or sobol"),
+                )
+            }),
+        }
     }
 
     fn integrator(&self, i: RawIntegrator) -> Result<IntegratorSettings, RenderError> {
@@ -574,4 +633,131 @@ impl Cx<'_> {
 fn show(v: &[f32]) -> String {
     let parts: Vec<String> = v.iter().map(|x| format!("{x}")).collect();
     format!("[{}]", parts.join(", "))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A film and a camera the renderer accepts.
+    const CAMERA: &str =
+        "[film]\nresolution = [32, 24]\n[camera]\ntype = \"perspective\"\nfov = 40.0\n";
+
+    /// The camera's part of `text`, or its error as (key, line, message).
+    fn camera_part(
+        text: &str,
+    ) -> Result<CameraDescription, (Option<String>, Option<usize>, String)> {
+        parse_camera_description(Path::new("s.toml"), text).map_err(|e| match e {
+            RenderError::Scene {
+                key, line, message, ..
+            } => (key, line, message),
+            other => panic!("not a scene error: {other}"),
+        })
+    }
+
+    /// The 1-based line of `text` that reads `line`.
+    fn line_of(text: &str, line: &str) -> usize {
+        text.lines().position(|l| l == line).expect(line) + 1
+    }
+
+    /// Each table the renderer refuses is skipped unread: the camera, its film and its sampler
+    /// type still come through, and the camera builds.
+    #[test]
+    fn a_scene_refused_elsewhere_still_gives_its_camera() {
+        for refused in [
+            "[[shapes]]\ntype = \"torus\"\nbogus = [\n  [1.0, 2.0],\n]\n",
+            "[[shapes]]\ntype = \"sphere\"\nradius = 1.0\nmaterial = \"undefined\"\n",
+            "[materials.m]\ntype = \"nonsense\"\n",
+            "[integrator]\ntype = \"mist\"\nmax_depth = 0\n",
+            "[[lights]]\ntype = \"laser\"\n",
+            "[foo]\nbar = 1\n",
+            "version = 3\nmaterials.y.type = \"nonsense\"\n",
+            "[sampler]\ntype = \"halton\"\nspp = 0\nbogus = 1\n",
+        ] {
+            let text = format!("{refused}{CAMERA}");
+            assert!(
+                parse_description(Path::new("s.toml"), &text).is_err(),
+                "the renderer refuses {refused}"
+            );
+            let d = camera_part(&text).unwrap_or_else(|e| panic!("{refused}: {e:?}"));
+            assert_eq!(d.film.resolution, [32, 24], "{refused}");
+            assert_eq!(d.camera.kind, CameraKind::Perspective, "{refused}");
+            assert_eq!(d.camera.fov, 40.0, "{refused}");
+            d.camera().unwrap_or_else(|e| panic!("{refused}: {e}"));
+        }
+    }
+
+    /// An error in `[camera]` (or `[film]`) names its key and its line in the file, past the
+    /// skipped tables before it; unknown keys in the tables read are still errors.
+    #[test]
+    fn camera_errors_name_their_key_and_the_files_line() {
+        let skipped = "[[shapes]]\ntype = \"torus\"\ntransform = [\n  [1.0, 0.0],\n]\n\
+                       [integrator]\ntype = \"mist\"\n";
+        for (film, camera, key) in [
+            ("", "fov = 180.0", "camera.fov"),
+            ("", "bogus = 1", "camera.bogus"),
+            ("", "eye = [0.0, 0.0]", "camera.eye"),
+            ("", "[camera.stereo]\nbogus = 1", "camera.stereo.bogus"),
+            ("crop = [0.5, 0.2, 0.0, 1.0]", "", "film.crop"),
+        ] {
+            let text = format!(
+                "{skipped}[film]\nresolution = [32, 24]\n{film}\n[camera]\n{camera}\n[[lights]]\n"
+            );
+            let written = [film, camera].concat();
+            let line = line_of(&text, written.lines().last().unwrap());
+            let (k, l, message) = camera_part(&text).expect_err(key);
+            assert_eq!(
+                (k.as_deref(), l),
+                (Some(key), Some(line)),
+                "{camera}{film}: {message}"
+            );
+        }
+    }
+
+    /// Of `[sampler]`, `type` alone is read: other keys, even unknown ones, are skipped, but
+    /// an unknown sampler is an error at its line.
+    #[test]
+    fn only_the_sampler_type_is_read() {
+        let d = camera_part(CAMERA).unwrap();
+        assert_eq!(d.sampler, SamplerKind::Sobol, "the format's default");
+        let text = format!("[sampler]\ntype = \"halton\"\nspp = 0\nseed = -1\nbogus = 1\n{CAMERA}");
+        assert_eq!(camera_part(&text).unwrap().sampler, SamplerKind::Halton);
+        let text = format!("[sampler]\nspp = 4\ntype = \"nope\"\n{CAMERA}");
+        let (key, line, message) = camera_part(&text).unwrap_err();
+        assert_eq!(
+            (key.as_deref(), line),
+            (Some("sampler.type"), Some(3)),
+            "{message}"
+        );
+        assert!(message.contains("unknown sampler `nope`"), "{message}");
+        // Written inline or with dotted keys, the type is read all the same.
+        for sampler in [
+            "sampler = { type = \"halton\", spp = 0 }\n",
+            "sampler.type = \"halton\"\nsampler.spp = 0\n",
+        ] {
+            let d = camera_part(&format!("{sampler}{CAMERA}")).unwrap();
+            assert_eq!(d.sampler, SamplerKind::Halton, "{sampler}");
+        }
+        let (key, _, message) = camera_part(&format!("sampler = 5\n{CAMERA}")).unwrap_err();
+        assert_eq!(key.as_deref(), Some("sampler"), "{message}");
+        assert!(message.ends_with("expected a table"), "{message}");
+    }
+
+    /// The skipped tables are still read as TOML: a syntax error in one is an error at its
+    /// line.
+    #[test]
+    fn a_syntax_error_anywhere_is_an_error() {
+        for (bad, at) in [
+            ("[[shapes]]\nradius = 1.0.0\n", "radius = 1.0.0"),
+            (
+                "[materials.m]\ntype = \"a\"\ntype = \"b\"\n",
+                "type = \"b\"",
+            ),
+            ("[integrator\ntype = \"path\"\n", "[integrator"),
+        ] {
+            let text = format!("{CAMERA}{bad}");
+            let (_, line, message) = camera_part(&text).expect_err(bad);
+            assert_eq!(line, Some(line_of(&text, at)), "{bad}: {message}");
+        }
+    }
 }

@@ -22,6 +22,26 @@ pub(super) struct RawScene {
     pub(super) lights: Vec<RawLight>,
 }
 
+/// The camera's part of a scene file: the tables of [`RawScene`] a camera reads. Keys and
+/// tables outside them are skipped, not denied (serde's default), so that a scene the renderer
+/// refuses elsewhere still gives its camera; the tables read keep their `deny_unknown_fields`.
+#[derive(Deserialize)]
+pub(super) struct RawCameraPart {
+    pub(super) film: RawFilm,
+    #[serde(default)]
+    pub(super) sampler: RawSamplerType,
+    pub(super) camera: RawCamera,
+}
+
+/// `[sampler] type` alone: the other sampler keys set up a render, not the camera, and are
+/// skipped. (`expecting` keeps this struct's name out of a message such as `sampler = 5`'s.)
+#[derive(Deserialize, Default)]
+#[serde(expecting = "a table")]
+pub(super) struct RawSamplerType {
+    #[serde(rename = "type")]
+    pub(super) kind: Option<String>,
+}
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawFilm {

@@ -50,14 +50,29 @@ pub struct SceneDescription {
 impl SceneDescription {
     /// A scene error at `key`, with the key's line in the file.
     pub(crate) fn error(&self, key: impl Into<String>, message: impl Into<String>) -> RenderError {
-        let key = key.into();
-        RenderError::Scene {
-            file: self.file.clone(),
-            line: crate::locate::line_of_key(&self.source, &key),
-            key: Some(key),
-            message: message.into(),
-        }
+        RenderError::at_key(&self.file, &self.source, &key.into(), message)
     }
+}
+
+/// The camera's part of a scene file, validated as [`SceneDescription`]'s is: `[camera]`,
+/// `[film]` and `[sampler] type`, and nothing of the scene the camera looks at. Made by
+/// [`parse_camera_description`](crate::parse_camera_description); its camera is
+/// [`CameraDescription::camera`].
+#[derive(Clone, Debug)]
+pub struct CameraDescription {
+    /// The scene file itself.
+    pub file: PathBuf,
+    /// `[film]`.
+    pub film: FilmSettings,
+    /// `[sampler] type`: the sampler that draws the camera's film, lens and time samples.
+    pub sampler: SamplerKind,
+    /// `[camera]`.
+    pub camera: CameraSettings,
+    /// `[camera]` keys that were given but that the chosen model ignores, as in
+    /// [`SceneDescription::ignored`].
+    pub ignored: Vec<String>,
+    /// The file's text: errors found after parsing find their key's line in it.
+    pub(crate) source: std::sync::Arc<str>,
 }
 
 /// `[film]`: the image's size and reconstruction filter.
