@@ -259,12 +259,12 @@ try {
     return d / a.length;
   }
   // The centroid of the blue sphere's pixels (blue well above red: not the grey floor, the
-  // red sphere or the black sky).
-  function blueCentroid(px) {
+  // red sphere or the black sky) in columns x0..x1 of an image `width` wide.
+  function blueCentroid(px, width = W, x0 = 0, x1 = W) {
     let sx = 0, sy = 0, n = 0;
     for (let y = 0; y < H; y++) {
-      for (let x = 0; x < W; x++) {
-        const i = (y * W + x) * 4;
+      for (let x = x0; x < x1; x++) {
+        const i = (y * width + x) * 4;
         if (px[i + 2] - px[i] > 60 && px[i + 2] > px[i + 1]) { sx += x + 0.5; sy += y + 0.5; n++; }
       }
     }
@@ -294,14 +294,72 @@ try {
     check('an emptied screen_window is removed', !back.error && !('screen_window' in back.camera) && meanDiff(pinhole.px, back.px) === 0,
       back.error || `mean |difference| from the pinhole ${meanDiff(pinhole.px, back.px)}`);
 
-    // [camera.stereo]: a key of the sub-table; the page says what it shows of a pair.
+    // [camera.stereo]: keys of the sub-table; the page shows the pair as `obscura render`
+    // lays it out. Side by side first: twice as wide, each half an eye.
     const pair = await setControl('stereo.convergence', '5');
-    const notice = await page.locator('#notice').textContent();
-    check('the stereo controls set [camera.stereo]', !pair.error && pair.camera.stereo?.convergence === 5 &&
-      notice.includes('camera.stereo'), pair.error || `${JSON.stringify(pair.camera.stereo)}; notice ${JSON.stringify(notice)}`);
+    const size = () => page.evaluate(() => [document.getElementById('view').width, document.getElementById('view').height]);
+    const notice = () => page.locator('#notice').textContent();
+    const sbsSize = await size();
+    check('the stereo controls set [camera.stereo]; the pair shows side by side', !pair.error &&
+      pair.camera.stereo?.convergence === 5 && sbsSize.join('x') === `${2 * W}x${H}` && !(await notice()).includes('midway'),
+      pair.error || `${JSON.stringify(pair.camera.stereo)}; canvas ${sbsSize}; notice ${JSON.stringify(await notice())}`);
+    // Each eye moves by b/2 along camera x and its window shifts so that the convergence
+    // plane (C = 5) lines up: a point at depth z is (H/2) b (1/z - 1/C) / tan(20 deg) pixels
+    // further right in the left eye than in the right. The far sphere (z = 12) with b = 0.5:
+    // 60 * 0.5 * (1/12 - 1/5) / 0.364 = -9.6 pixels, the left eye's image on the left.
+    const B = 0.5, C = 5, Z = EYE[2] - BLUE.c[2];
+    const parallax = (H / 2) * B * (1 / Z - 1 / C) / TAN;
+    const [cx, cy] = project(BLUE.c);
+    const wider = await setControl('stereo.interaxial', String(B));
+    const left = blueCentroid(wider.px, 2 * W, 0, W), right = blueCentroid(wider.px, 2 * W, W, 2 * W);
+    right[0] -= W;
+    check('the interaxial restarts the render; each half is its eye, with the parallax of the rig',
+      !wider.error && near(left, [cx + parallax / 2, cy], 1.5) && near(right, [cx - parallax / 2, cy], 1.5),
+      wider.error || `left eye ${fmt2(left)}, right eye ${fmt2(right)}; predicted ${fmt2([cx + parallax / 2, cy])}, ${fmt2([cx - parallax / 2, cy])}`);
+    await page.screenshot({ path: join(out, '7-stereo-side-by-side.png') });
+
+    // Anaglyph: one image; red from the left eye, green and blue from the right. Above the
+    // horizon and right of the red sphere only the far sphere is in front of the black sky,
+    // so there the red channel's centroid is the left eye's sphere, the blue the right's.
+    const ana = await setControl('stereo.layout', 'anaglyph');
+    const anaSize = await size();
+    function channelCentroid(px, ch) {
+      let sx = 0, n = 0;
+      for (let y = 30; y < 58; y++) {
+        for (let x = 70; x < 135; x++) { const v = px[(y * W + x) * 4 + ch]; sx += v * (x + 0.5); n += v; }
+      }
+      return sx / n;
+    }
+    const red = channelCentroid(ana.px, 0), blue = channelCentroid(ana.px, 2);
+    check('an anaglyph: red from the left eye, cyan from the right', !ana.error && anaSize.join('x') === `${W}x${H}` &&
+      Math.abs(red - (cx + parallax / 2)) < 1.5 && Math.abs(blue - (cx - parallax / 2)) < 1.5,
+      ana.error || `canvas ${anaSize}; red centroid ${red.toFixed(2)}, blue ${blue.toFixed(2)}; predicted ` +
+      `${(cx + parallax / 2).toFixed(2)}, ${(cx - parallax / 2).toFixed(2)}`);
+    await page.screenshot({ path: join(out, '8-stereo-anaglyph.png') });
+
+    // Separate: shown side by side, the page says so, and the image saves one file per eye.
+    const sep = await setControl('stereo.layout', 'separate');
+    const sepSize = await size();
+    const saves = await page.evaluate(async () => {
+      const right = document.getElementById('save-png-right');
+      const r = await fetch(right.href);
+      const b = new Uint8Array(await r.arrayBuffer());
+      const v = new DataView(b.buffer);
+      return { hidden: right.hidden, left: document.getElementById('save-png').href, status: r.status,
+        size: [v.getUint32(16), v.getUint32(20)] };
+    });
+    check('a separate pair shows side by side, says so, and saves each eye', !sep.error && sepSize.join('x') === `${2 * W}x${H}` &&
+      (await notice()).includes('separate') && !saves.hidden && saves.left.includes('eye=left') && saves.status === 200 &&
+      saves.size.join('x') === `${W}x${H}`, sep.error || `canvas ${sepSize}; ${JSON.stringify(saves)}; notice ${JSON.stringify(await notice())}`);
+
+    // Emptied, the keys go one by one, and the table with the last.
+    for (const key of ['stereo.layout', 'stereo.interaxial']) {
+      const r = await setControl(key, '');
+      check(`emptying ${key} removes it`, !r.error && !(key.split('.')[1] in (r.camera.stereo || {})), r.error || JSON.stringify(r.camera.stereo));
+    }
     const single = await setControl('stereo.convergence', '');
-    check('emptying the last stereo key removes [camera.stereo]', !single.error && !('stereo' in single.camera),
-      single.error || JSON.stringify(single.camera));
+    check('emptying the last stereo key removes [camera.stereo]', !single.error && !('stereo' in single.camera) &&
+      meanDiff(pinhole.px, single.px) === 0, single.error || JSON.stringify(single.camera));
 
     // pose: the look-at's own matrix (world from camera: camera x, y, z along world x, y, -z,
     // at the eye) renders the same picture; the look-at keys go, since the pose is given one

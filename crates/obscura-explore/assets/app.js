@@ -72,7 +72,7 @@ const CONTROLS = [
     models: ['perspective', 'ods'] },
   { key: 'stereo.convergence', kind: 'number', optional: true, models: ['perspective'] },
   { key: 'stereo.layout', kind: 'select', options: ['side_by_side', 'separate', 'anaglyph'],
-    def: 'side_by_side', models: ['perspective'] },
+    def: 'side_by_side', optional: true, models: ['perspective'] },
 ];
 
 // The ways of giving the pose: the keys that always go together, and what the others' fields
@@ -87,7 +87,8 @@ const ctx = canvas.getContext('2d', { willReadFrequently: true });
 // What the page knows; window.explorer lets tests read it.
 const state = {
   session: null, camera: {}, resolution: [1, 1], spp: 1, generation: 0,
-  frame: { generation: -1, pass: 0, passes: 0 }, effective: {}, clamped: [], lastError: null,
+  frame: { generation: -1, pass: 0, passes: 0 }, effective: {}, clamped: [], stereo: null,
+  lastError: null,
 };
 window.explorer = state;
 
@@ -192,8 +193,10 @@ function buildControls(types) {
     if (c.kind === 'select') {
       const sel = document.createElement('select');
       sel.id = idOf(c.key);
+      // An optional key's empty choice removes it (the format's default applies).
+      if (c.optional) sel.append(new Option(`(default: ${c.def})`, ''));
       for (const o of c.options) sel.append(new Option(o, o));
-      sel.addEventListener('change', () => setCamera(c.key, sel.value));
+      sel.addEventListener('change', () => setCamera(c.key, c.optional && sel.value === '' ? null : sel.value));
       label.append(sel);
     } else if (c.kind === 'range') {
       const input = document.createElement('input');
@@ -264,7 +267,8 @@ function showControls() {
     if (c.pose) {
       input.placeholder = unused ? `(pose from ${POSE_NAMES[pose]})` : c.placeholder || (c.optional ? '(none)' : '');
     }
-    const v = unused ? undefined : valueOf(c.key);
+    // An optional choice shows empty (its default) while the view does not give it.
+    const v = unused ? undefined : c.kind === 'select' && c.optional ? cameraValue(c.key) ?? '' : valueOf(c.key);
     if (c.kind === 'vec' || c.kind === 'list') input.value = v === undefined ? '' : v.map(c.exact ? String : fmt).join(', ');
     else if (c.kind === 'json') input.value = v === undefined ? '' : JSON.stringify(v);
     else if (v !== undefined) input.value = v;
@@ -276,8 +280,16 @@ function showControls() {
   $('spp').value = state.spp;
   const q = `?session=${state.session}`;
   $('save-toml').href = '/api/scene.toml' + q;
-  $('save-png').href = '/api/image.png' + q;
-  $('save-exr').href = '/api/image.exr' + q;
+  // A `separate` stereo pair saves one file per eye, as `obscura render` writes it.
+  const separate = !!state.stereo && state.stereo.layout === 'separate';
+  for (const ext of ['png', 'exr']) {
+    const [one, right] = [$(`save-${ext}`), $(`save-${ext}-right`)];
+    one.href = `/api/image.${ext}` + q + (separate ? '&eye=left' : '');
+    one.download = separate ? `view-left.${ext}` : `view.${ext}`;
+    one.textContent = `${separate ? 'left image' : 'image'} (.${ext})`;
+    right.href = `/api/image.${ext}` + q + '&eye=right';
+    right.hidden = !separate;
+  }
 }
 
 function showError(message) {
@@ -286,12 +298,13 @@ function showError(message) {
 }
 
 // What the page shows differs from what the scene file asks for: the settings previewed at
-// the explorer's limits, and a stereo pair shown from between its eyes.
+// the explorer's limits, and a `separate` stereo pair shown side by side in the one image.
 function showNotices() {
   const notes = state.clamped.map((c) => c.message);
-  if (currentType() === 'perspective' && state.camera.stereo) {
-    notes.push('camera.stereo: the explorer shows the view from midway between the eyes; ' +
-      '`obscura render` writes the pair as its layout says');
+  if (state.stereo && state.stereo.layout === 'separate') {
+    notes.push('camera.stereo.layout = separate: the preview shows the left and right eyes ' +
+      'side by side; `obscura render` writes them as NAME-left and NAME-right, and the image ' +
+      'saves one file per eye');
   }
   $('notice').textContent = notes.join(' · ');
 }
@@ -301,6 +314,7 @@ function takeView(msg) {
   state.resolution = msg.resolution;
   state.spp = msg.spp;
   state.clamped = msg.clamped || [];
+  state.stereo = msg.stereo || null;
   state.effective = msg.effective || {};
   if (msg.generation !== undefined) state.generation = msg.generation;
   showError(null);
@@ -414,7 +428,10 @@ async function hover(e) {
       const res = await fetch(`/api/coords?session=${state.session}&x=${x}&y=${y}`);
       const c = await res.json();
       const v3 = (a) => a.map((n) => n.toFixed(3).padStart(8)).join(' ');
-      let text = `raster ${v3(c.raster)}\n`;
+      // A stereo pair's image: the coordinates are on the film of the eye under the pointer
+      // (an anaglyph's, the rig centre's).
+      let text = c.eye ? `eye    ${c.eye}\n` : '';
+      text += `raster ${v3(c.raster)}\n`;
       if (c.projective) {
         const p = c.projective;
         text += `NDC    ${v3(p.ndc)}\nscreen ${v3(p.screen)}\ncamera ${v3(p.camera)}  (on the near plane)\n`;

@@ -8,7 +8,10 @@
 //!   page asking for more is refused, a scene file asking for more is previewed at them
 //!   ([`Clamp`]);
 //! - [`Session`] is one page: its scene built once, one worker thread rendering its view pass by
-//!   pass, cancelled and restarted on every change;
+//!   pass, cancelled and restarted on every change; a perspective stereo pair renders both
+//!   eyes each pass and is shown composed as `obscura render` composes it (side by side, or
+//!   the red-cyan anaglyph; a `separate` pair side by side), its two films counting twice
+//!   against the pixel limits;
 //! - [`router`] is the API and the embedded page (no outside hosts); [`run`] serves it.
 //!
 //! See docs/explorer.md for the API.
@@ -18,6 +21,7 @@ mod error;
 mod request;
 mod server;
 mod session;
+mod stereo;
 mod view;
 
 pub use error::ExploreError;

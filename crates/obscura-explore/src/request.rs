@@ -119,6 +119,11 @@ impl Params {
             })
     }
 
+    /// The text of `key`, where given.
+    pub(crate) fn optional(&self, key: &str) -> Option<&str> {
+        self.0.get(key).map(String::as_str)
+    }
+
     /// The text of `key`, which the request needs.
     pub(crate) fn text(&self, key: &str) -> Result<&str, ExploreError> {
         self.0

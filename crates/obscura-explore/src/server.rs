@@ -2,7 +2,8 @@
 
 use crate::error::ExploreError;
 use crate::request::{Params, pixel};
-use crate::session::{Session, coordinates, depth_at, png_bytes};
+use crate::session::{Session, coordinates, png_bytes, preview_depth};
+use crate::stereo::{Pick, eye_name, eye_of_name, layout_name, pair_layout, pick, shown};
 use crate::view::{MAX_EDGE, MAX_PIXELS, MAX_SPP, View, ViewChange};
 use axum::Router;
 use axum::body::Bytes;
@@ -12,9 +13,11 @@ use axum::extract::{Path as UrlPath, State};
 use axum::http::{StatusCode, header};
 use axum::response::{IntoResponse, Response};
 use axum::routing::{get, post};
+use obscura_camera::{Camera, StereoEye};
 use obscura_render::{
-    CameraKind, DepthOfField, ImageInfo, RenderOptions, RenderScene, depth_of_field, motion_blur,
-    render, screen_buffers, write_image,
+    CameraKind, DepthOfField, Image, ImageInfo, RenderOptions, RenderScene, SceneDescription,
+    StereoLayout, camera_of, compose_stereo, depth_of_field, motion_blur, render, screen_buffers,
+    write_image,
 };
 use serde_json::{Value as Json, json};
 use std::collections::HashMap;
@@ -171,15 +174,31 @@ async fn asset(UrlPath(file): UrlPath<String>) -> Response {
     ([(header::CONTENT_TYPE, kind)], body).into_response()
 }
 
-/// The view's parameters as the page shows them: `resolution` and `spp` as rendered, and
-/// `clamped` the scene file's settings previewed at the explorer's limits.
+/// The view's parameters as the page shows them: `resolution` and `spp` as rendered (per eye
+/// of a stereo pair), `clamped` the scene file's settings previewed at the explorer's limits,
+/// and `stereo` how a pair is shown (null for a single view).
 fn view_json(view: &View) -> Json {
     let d = view.description();
+    let [w, h] = d.film.resolution;
+    let stereo = pair_layout(d).map(|layout| {
+        let shown = shown(layout);
+        let width = if shown == StereoLayout::Anaglyph {
+            w
+        } else {
+            2 * w
+        };
+        json!({
+            "layout": layout_name(layout),
+            "shown": layout_name(shown),
+            "image": [width, h],
+        })
+    });
     json!({
         "camera": view.camera_json(),
         "resolution": d.film.resolution,
         "spp": d.sampler.spp,
         "clamped": view.clamps(),
+        "stereo": stereo,
         "effective": {
             "type": d.camera.kind.name(),
             "lens_radius": d.camera.lens.radius,
@@ -252,7 +271,7 @@ async fn focus(State(x): Api, q: Params, body: Bytes) -> Result<Response, Explor
         Some(s) => {
             let depth = {
                 let s = s.clone();
-                blocking(move || s.with_scene(|scene| depth_at(scene, px, py))).await?
+                blocking(move || s.depth_at(px, py)).await?
             };
             let mut change = ViewChange::default();
             change.camera.insert("focal_distance".into(), json!(depth));
@@ -265,8 +284,7 @@ async fn focus(State(x): Api, q: Params, body: Bytes) -> Result<Response, Explor
         None => {
             let base = x.base.clone();
             let depth = blocking(move || {
-                let scene = RenderScene::build(base.description().clone())?;
-                depth_at(&scene, px, py)
+                preview_depth(RenderScene::build(base.description().clone())?, px, py)
             })
             .await?;
             Ok(axum::Json(json!({ "depth": depth })).into_response())
@@ -274,11 +292,32 @@ async fn focus(State(x): Api, q: Params, body: Bytes) -> Result<Response, Explor
     }
 }
 
+/// The coordinates under a position of the page's image: for a stereo pair's side-by-side
+/// image, on the film of the eye whose half it is in (`eye`: "left" or "right"); for an
+/// anaglyph, the rig centre's (`eye`: "centre"), which sees a point midway between its red
+/// and cyan images.
 async fn coords(State(x): Api, q: Params) -> Result<Response, ExploreError> {
     let (px, py) = (q.finite("x")?, q.finite("y")?);
     let view = x.view_of(q.session()?)?;
-    let camera = obscura_render::camera_of(view.description())?;
-    Ok(axum::Json(coordinates(&camera, px, py)).into_response())
+    let d = view.description();
+    let centre = camera_of(d)?;
+    let Some(layout) = pair_layout(d) else {
+        let mut c = coordinates(&centre, px, py);
+        c["eye"] = Json::Null;
+        return Ok(axum::Json(c).into_response());
+    };
+    let [x0, x1, _, _] = Camera::film(&centre).pixel_bounds();
+    let Pick { eye, x: ex, y: ey } = pick(Some(shown(layout)), x1 - x0, px, py);
+    let (camera, name) = match (eye, d.stereo_eyes()) {
+        (Some(eye), Some([left, right])) => {
+            let eye_d = if eye == StereoEye::Left { left } else { right };
+            (camera_of(&eye_d)?, eye_name(eye))
+        }
+        _ => (centre, "centre"),
+    };
+    let mut c = coordinates(&camera, ex, ey);
+    c["eye"] = json!(name);
+    Ok(axum::Json(c).into_response())
 }
 
 async fn scene_toml(State(x): Api, q: Params) -> Result<Response, ExploreError> {
@@ -296,22 +335,59 @@ async fn scene_toml(State(x): Api, q: Params) -> Result<Response, ExploreError> 
         .into_response())
 }
 
-fn latest(x: &Explorer, q: &Params) -> Result<(obscura_render::Image, u32), ExploreError> {
+/// The latest frame to save, its passes and its file name's stem: what `obscura render`
+/// writes of the view. A stereo pair laid out side by side or as an anaglyph is one image,
+/// composed; a `separate` pair is two files (`view-left`, `view-right`), so the request names
+/// the eye (`eye=left|right`, which any pair may name).
+fn latest(x: &Explorer, q: &Params) -> Result<(Image, u32, String), ExploreError> {
     let s = x.named_session(q)?;
-    s.latest_image()
-        .map(|(image, _, passes)| (image, passes))
-        .ok_or_else(|| ExploreError::NothingThere("no frame rendered yet".into()))
+    let eye = q
+        .optional("eye")
+        .map(|name| {
+            eye_of_name(name).ok_or_else(|| ExploreError::Malformed {
+                key: "eye".into(),
+                message: format!("must be \"left\" or \"right\", got {name:?}"),
+            })
+        })
+        .transpose()?;
+    let none_yet = || ExploreError::NothingThere("no frame rendered yet".into());
+    let (image, _, passes) = s.latest_image().ok_or_else(none_yet)?;
+    match (s.latest_eyes(), eye) {
+        (None, None) => Ok((image, passes, "view".into())),
+        (None, Some(_)) => Err(ExploreError::Refused {
+            key: "eye".into(),
+            message: "the view is not a stereo pair ([camera.stereo] on a perspective camera)"
+                .into(),
+        }),
+        (Some(([left, right], _, _, passes)), Some(eye)) => {
+            let image = if eye == StereoEye::Left { left } else { right };
+            Ok((image, passes, format!("view-{}", eye_name(eye))))
+        }
+        (Some((_, StereoLayout::Separate, _, _)), None) => Err(ExploreError::Refused {
+            key: "eye".into(),
+            message: "camera.stereo.layout = \"separate\" saves each eye to its own file, as \
+                      `obscura render` writes NAME-left and NAME-right: ask for eye=left or \
+                      eye=right"
+                .into(),
+        }),
+        (Some(_), None) => Ok((image, passes, "view".into())),
+    }
+}
+
+/// `attachment; filename="NAME"`.
+fn attachment(name: &str) -> String {
+    format!("attachment; filename=\"{name}\"")
 }
 
 async fn image_png(State(x): Api, q: Params) -> Result<Response, ExploreError> {
-    let (image, _) = latest(&x, &q)?;
+    let (image, _, stem) = latest(&x, &q)?;
     let png = blocking(move || png_bytes(&image)).await?;
     Ok((
         [
-            (header::CONTENT_TYPE, "image/png"),
+            (header::CONTENT_TYPE, "image/png".to_string()),
             (
                 header::CONTENT_DISPOSITION,
-                "attachment; filename=\"view.png\"",
+                attachment(&format!("{stem}.png")),
             ),
         ],
         png,
@@ -320,7 +396,7 @@ async fn image_png(State(x): Api, q: Params) -> Result<Response, ExploreError> {
 }
 
 async fn image_exr(State(x): Api, q: Params) -> Result<Response, ExploreError> {
-    let (image, passes) = latest(&x, &q)?;
+    let (image, passes, stem) = latest(&x, &q)?;
     let exr = blocking(move || {
         // The EXR writer writes files; a private temporary one, read back and removed.
         let path = std::env::temp_dir().join(format!(
@@ -345,10 +421,10 @@ async fn image_exr(State(x): Api, q: Params) -> Result<Response, ExploreError> {
     .await?;
     Ok((
         [
-            (header::CONTENT_TYPE, "image/x-exr"),
+            (header::CONTENT_TYPE, "image/x-exr".to_string()),
             (
                 header::CONTENT_DISPOSITION,
-                "attachment; filename=\"view.exr\"",
+                attachment(&format!("{stem}.exr")),
             ),
         ],
         exr,
@@ -359,7 +435,8 @@ async fn image_exr(State(x): Api, q: Params) -> Result<Response, ExploreError> {
 static TEMP_COUNTER: AtomicU64 = AtomicU64::new(0);
 
 /// Potmesil and Chakravarty's post-process blur of a pinhole image of the view, for
-/// comparison with the distributed render.
+/// comparison with the distributed render: for a stereo pair, of each eye, composed as the
+/// page shows the pair.
 async fn postprocess(State(x): Api, q: Params) -> Result<Response, ExploreError> {
     let dof = match q.text("effect")? {
         "dof" => true,
@@ -375,8 +452,6 @@ async fn postprocess(State(x): Api, q: Params) -> Result<Response, ExploreError>
     let threads = x.threads;
     let png = blocking(move || {
         let d = view.description();
-        let real = RenderScene::build(d.clone())?;
-        let buffers = screen_buffers(&real);
         let open = d.camera.shutter.open;
         let mut change = ViewChange {
             spp: Some(d.sampler.spp.min(POSTPROCESS_SPP)),
@@ -386,29 +461,58 @@ async fn postprocess(State(x): Api, q: Params) -> Result<Response, ExploreError>
         if dof {
             change.camera.insert("lens_radius".into(), json!(0.0));
         }
-        let sharp = RenderScene::build(view.apply(&change)?.description().clone())?;
-        let outcome = render(
-            &sharp,
-            RenderOptions {
-                threads,
-                ..Default::default()
-            },
-        )
-        .map_err(|e| ExploreError::Internal(e.to_string()))?;
-        let image = outcome.film.resolve();
-        let blurred = if dof {
-            depth_of_field(
-                &image,
-                &buffers.depth,
-                &DepthOfField::for_camera(&real.camera)?,
-            )?
-        } else {
-            motion_blur(&image, &buffers.velocity)?
+        let sharp = view.apply(&change)?;
+        let blur = |real: SceneDescription, sharp: SceneDescription| {
+            postprocessed(real, sharp, dof, threads)
         };
-        png_bytes(&blurred)
+        let image = match (
+            pair_layout(d),
+            d.stereo_eyes(),
+            sharp.description().stereo_eyes(),
+        ) {
+            (Some(layout), Some([real_left, real_right]), Some([sharp_left, sharp_right])) => {
+                let (left, right) = (blur(real_left, sharp_left)?, blur(real_right, sharp_right)?);
+                compose_stereo(&left, &right, shown(layout)).ok_or_else(|| {
+                    ExploreError::Internal("no single image of the pair's layout".into())
+                })?
+            }
+            _ => blur(d.clone(), sharp.description().clone())?,
+        };
+        png_bytes(&image)
     })
     .await?;
     Ok(([(header::CONTENT_TYPE, "image/png")], png).into_response())
+}
+
+/// The post-process blur of `sharp` (a pinhole, instantaneous render of the view `real`) by
+/// `real`'s depth (`dof`) or raster velocity buffers.
+fn postprocessed(
+    real: SceneDescription,
+    sharp: SceneDescription,
+    dof: bool,
+    threads: Option<usize>,
+) -> Result<Image, ExploreError> {
+    let real = RenderScene::build(real)?;
+    let buffers = screen_buffers(&real);
+    let sharp = RenderScene::build(sharp)?;
+    let outcome = render(
+        &sharp,
+        RenderOptions {
+            threads,
+            ..Default::default()
+        },
+    )
+    .map_err(|e| ExploreError::Internal(e.to_string()))?;
+    let image = outcome.film.resolve();
+    Ok(if dof {
+        depth_of_field(
+            &image,
+            &buffers.depth,
+            &DepthOfField::for_camera(&real.camera)?,
+        )?
+    } else {
+        motion_blur(&image, &buffers.velocity)?
+    })
 }
 
 async fn websocket(

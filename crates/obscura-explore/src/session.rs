@@ -6,18 +6,24 @@
 //! render's cancel flag, so the render in flight stops at its next pass boundary and the worker
 //! starts the new view from pass 0; changes that arrive meanwhile are coalesced into the
 //! latest. There is never more than one render per session.
+//!
+//! A stereo pair renders pass by pass too: each pass takes one sample per pixel of the left
+//! eye, then of the right, each eye into its own film (the scene's camera swapped between
+//! them), and the frame is the pair composed as `obscura render` composes it. The films' sums
+//! are exact, so a pair rendered pass by pass is the command line's pair, bit for bit.
 
 use crate::error::ExploreError;
+use crate::stereo::{Pick, cameras_of, pair_layout, pick, shown};
 use crate::view::{View, ViewChange};
-use obscura_camera::{AnyCamera, Camera, CameraSample};
+use obscura_camera::{AnyCamera, Camera, CameraSample, StereoEye};
 use obscura_render::{
-    Film, Image, PixelRect, RenderOptions, RenderScene, SceneDescription, camera_of, render,
-    srgb_8bit,
+    Film, Image, PixelRect, RenderOptions, RenderScene, SceneDescription, StereoLayout, camera_of,
+    compose_stereo, render, srgb_8bit,
 };
 use obscura_sample::Sampler;
 use obscura_space::{Camera as CameraSpace, Ndc, Point2, Point3, Raster, Screen};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::sync::{Arc, Condvar, Mutex, MutexGuard, RwLock};
+use std::sync::{Arc, Condvar, Mutex, MutexGuard, RwLock, RwLockReadGuard, RwLockWriteGuard};
 use tokio::sync::watch;
 
 /// One progressive pass of a view, encoded for the page.
@@ -55,6 +61,83 @@ pub struct Status {
     pub renders_running: u64,
 }
 
+/// The latest frame's images.
+#[derive(Clone)]
+struct Latest {
+    /// The frame as the page shows it (a stereo pair composed).
+    image: Image,
+    /// A stereo pair's eyes (left, right) and the layout its scene file gives it.
+    eyes: Option<(Arc<[Image; 2]>, StereoLayout)>,
+    /// The frame's view generation.
+    generation: u64,
+    /// Passes in the frame.
+    passes: u32,
+}
+
+/// The scene as the worker renders it, with the view's cameras for the page's questions.
+struct Stage {
+    /// The scene. Its camera is the view's, except while an eye of a stereo pair renders:
+    /// then that eye's (only the worker changes it).
+    scene: RenderScene,
+    /// The view's camera: a stereo pair's rig centre.
+    centre: AnyCamera,
+    /// A stereo pair's eyes (left, right) and how the preview shows them.
+    pair: Option<([AnyCamera; 2], StereoLayout)>,
+}
+
+impl Stage {
+    /// The stage of a scene built for a view.
+    fn new(scene: RenderScene) -> Result<Stage, ExploreError> {
+        let (centre, eyes) = cameras_of(&scene.description)?;
+        let layout = pair_layout(&scene.description).map(shown);
+        Ok(Stage {
+            scene,
+            centre,
+            pair: eyes.zip(layout),
+        })
+    }
+
+    /// Points the stage at the view `d`; untouched when that fails.
+    fn set_view(&mut self, d: &SceneDescription) -> Result<(), ExploreError> {
+        let (centre, eyes) = cameras_of(d)?;
+        set_view(&mut self.scene, d)?;
+        self.centre = centre;
+        self.pair = eyes.zip(pair_layout(d).map(shown));
+        Ok(())
+    }
+
+    /// The camera-space depth of the first surface under preview position (`x`, `y`): a
+    /// stereo pair's preview position picks the eye ([`pick`]).
+    fn depth_at(&self, x: f32, y: f32) -> Result<f32, ExploreError> {
+        let Some((eyes, layout)) = &self.pair else {
+            return depth_through(&self.scene, &self.centre, x, y);
+        };
+        let b = self.scene.pixel_bounds;
+        let (w, h) = (b.x1 - b.x0, b.y1 - b.y0);
+        let preview_w = match layout {
+            StereoLayout::Anaglyph => w,
+            _ => 2 * w,
+        };
+        if !(x.is_finite() && y.is_finite())
+            || x < 0.0
+            || y < 0.0
+            || x >= preview_w as f32
+            || y >= h as f32
+        {
+            return Err(ExploreError::NothingThere(format!(
+                "({x}, {y}) is off the stereo pair's preview [0, {preview_w}) x [0, {h})"
+            )));
+        }
+        let Pick { eye, x, y } = pick(Some(*layout), w, x, y);
+        let camera = match eye {
+            None => &self.centre,
+            Some(StereoEye::Left) => &eyes[0],
+            Some(StereoEye::Right) => &eyes[1],
+        };
+        depth_through(&self.scene, camera, x, y)
+    }
+}
+
 /// The view waiting to be rendered, under the session's lock.
 struct State {
     view: View,
@@ -68,8 +151,8 @@ struct Shared {
     state: Mutex<State>,
     wake: Condvar,
     cancel: AtomicBool,
-    scene: RwLock<RenderScene>,
-    latest: Mutex<Option<(Image, u64, u32)>>,
+    stage: RwLock<Stage>,
+    latest: Mutex<Option<Latest>>,
     frames: watch::Sender<Option<Frame>>,
     status: Mutex<Status>,
     running: AtomicU64,
@@ -86,11 +169,21 @@ fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|e| e.into_inner())
 }
 
+/// Reads the stage (consistent even if a holder panicked, as for [`lock`]).
+fn read(stage: &RwLock<Stage>) -> RwLockReadGuard<'_, Stage> {
+    stage.read().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Writes the stage (consistent even if a holder panicked, as for [`lock`]).
+fn write(stage: &RwLock<Stage>) -> RwLockWriteGuard<'_, Stage> {
+    stage.write().unwrap_or_else(|e| e.into_inner())
+}
+
 impl Session {
     /// Builds the scene of `view` (blocking: call off the async runtime) and starts rendering
     /// it with `threads` workers (None: one per core).
     pub fn start(view: View, threads: Option<usize>) -> Result<Session, ExploreError> {
-        let scene = RenderScene::build(view.description().clone())?;
+        let stage = Stage::new(RenderScene::build(view.description().clone())?)?;
         let (frames, _) = watch::channel(None);
         let shared = Arc::new(Shared {
             state: Mutex::new(State {
@@ -101,7 +194,7 @@ impl Session {
             }),
             wake: Condvar::new(),
             cancel: AtomicBool::new(false),
-            scene: RwLock::new(scene),
+            stage: RwLock::new(stage),
             latest: Mutex::new(None),
             frames,
             status: Mutex::new(Status::default()),
@@ -126,8 +219,9 @@ impl Session {
     pub fn change(&self, change: &ViewChange) -> Result<(u64, View), ExploreError> {
         let mut state = lock(&self.shared.state);
         let view = state.view.apply(change)?;
-        // The camera crate's checks, which the scene layer may leave to build time.
-        camera_of(view.description())?;
+        // The camera crate's checks, which the scene layer may leave to build time (both
+        // eyes' for a stereo pair).
+        cameras_of(view.description())?;
         state.generation += 1;
         state.view = view.clone();
         state.pending = Some((view.clone(), state.generation));
@@ -149,16 +243,32 @@ impl Session {
         s
     }
 
-    /// The latest image (linear RGBA), its view's generation and its passes.
+    /// The latest image (linear RGBA) as the page shows it (a stereo pair composed), its
+    /// view's generation and its passes.
     pub fn latest_image(&self) -> Option<(Image, u64, u32)> {
-        lock(&self.shared.latest).clone()
+        lock(&self.shared.latest)
+            .as_ref()
+            .map(|l| (l.image.clone(), l.generation, l.passes))
     }
 
-    /// Runs `f` on the session's scene as built for the latest rendered view (blocking while
-    /// the worker swaps in a new camera).
-    pub fn with_scene<T>(&self, f: impl FnOnce(&RenderScene) -> T) -> T {
-        let scene = self.shared.scene.read().unwrap_or_else(|e| e.into_inner());
-        f(&scene)
+    /// The latest frame's stereo pair: the left and right eyes' images (linear RGBA), the
+    /// layout its scene file gives it, its view's generation and its passes; None when the
+    /// latest frame is of a single view (or there is none yet).
+    pub fn latest_eyes(&self) -> Option<([Image; 2], StereoLayout, u64, u32)> {
+        let latest = lock(&self.shared.latest);
+        let l = latest.as_ref()?;
+        let (eyes, layout) = l.eyes.as_ref()?;
+        Some(((**eyes).clone(), *layout, l.generation, l.passes))
+    }
+
+    /// The camera-space depth (z at shutter open) of the first surface under position
+    /// (`x`, `y`) of the page's image, from the lens centre, in the scene as built for the
+    /// latest rendered view: the `focal_distance` that brings it into focus. In a stereo
+    /// pair's side-by-side image each half is its eye's film; in an anaglyph the rig's centre
+    /// answers (its view is midway between the eyes' images of a point). Blocks while the
+    /// worker swaps in a new camera.
+    pub fn depth_at(&self, x: f32, y: f32) -> Result<f32, ExploreError> {
+        read(&self.shared.stage).depth_at(x, y)
     }
 }
 
@@ -189,69 +299,184 @@ impl Shared {
                     state = self.wake.wait(state).unwrap_or_else(|e| e.into_inner());
                 }
             };
-            {
-                let mut scene = self.scene.write().unwrap_or_else(|e| e.into_inner());
-                if let Err(e) = set_view(&mut scene, view.description()) {
+            let pair = {
+                let mut stage = write(&self.stage);
+                if let Err(e) = stage.set_view(view.description()) {
                     // Validated already in `change`; a failure here (a map unreadable since)
                     // leaves the old scene and no frame.
                     eprintln!("obscura serve: {e}");
                     continue;
                 }
+                stage.pair.clone()
+            };
+            self.running.fetch_add(1, Ordering::SeqCst);
+            lock(&self.status).renders_started += 1;
+            let done = match pair {
+                None => self.render_view(generation),
+                Some((eyes, shown)) => {
+                    let layout = view.description().camera.stereo.map_or(shown, |s| s.layout);
+                    self.render_pair(generation, eyes, shown, layout)
+                }
+            };
+            match done {
+                Ok(true) => {}
+                Ok(false) => lock(&self.status).renders_cancelled += 1,
+                Err(e) => eprintln!("obscura serve: {e}"),
             }
-            self.render_view(generation);
+            self.running.fetch_sub(1, Ordering::SeqCst);
         }
     }
 
-    fn render_view(&self, generation: u64) {
-        let scene = self.scene.read().unwrap_or_else(|e| e.into_inner());
-        self.running.fetch_add(1, Ordering::SeqCst);
-        lock(&self.status).renders_started += 1;
+    /// Renders a single view, sending each pass; Ok(false) when a change cancelled it.
+    fn render_view(&self, generation: u64) -> Result<bool, ExploreError> {
+        let stage = read(&self.stage);
+        let scene = &stage.scene;
         let passes = scene.sampler.samples_per_pixel();
         let on_pass = |done: u32, all: u32, film: &Film| {
-            if self.cancel.load(Ordering::SeqCst) {
-                return;
-            }
-            let image = film.resolve();
-            let png = match png_bytes(&image) {
-                Ok(p) => p,
-                Err(e) => {
-                    eprintln!("obscura serve: {e}");
-                    return;
-                }
-            };
-            *lock(&self.latest) = Some((image, generation, done));
-            {
-                let mut s = lock(&self.status);
-                if s.frame_generation != generation || s.passes_done == 0 {
-                    s.first_pass = done;
-                }
-                s.frame_generation = generation;
-                s.passes_done = done;
-                s.passes = all;
-            }
-            self.frames.send_replace(Some(Frame {
-                generation,
-                pass: done,
-                passes: all,
-                png: Arc::new(png),
-            }));
+            self.publish(generation, done, all, film.resolve(), None);
         };
         let outcome = render(
-            &scene,
+            scene,
             RenderOptions {
                 threads: self.threads,
                 cancel: Some(&self.cancel),
                 on_pass: Some(&on_pass),
                 ..Default::default()
             },
-        );
-        match outcome {
-            Ok(o) if o.passes_done < passes => lock(&self.status).renders_cancelled += 1,
-            Ok(_) => {}
-            Err(e) => eprintln!("obscura serve: cannot start the render threads: {e}"),
-        }
-        self.running.fetch_sub(1, Ordering::SeqCst);
+        )
+        .map_err(threads_error)?;
+        Ok(outcome.passes_done >= passes)
     }
+
+    /// Renders a stereo pair pass by pass, the left eye's pass then the right's, each into
+    /// its own film, sending each pass composed as `shown`; Ok(false) when a change cancelled
+    /// it. `layout` is the scene file's (kept with the eyes for saving them).
+    fn render_pair(
+        &self,
+        generation: u64,
+        eyes: [AnyCamera; 2],
+        shown: StereoLayout,
+        layout: StereoLayout,
+    ) -> Result<bool, ExploreError> {
+        let (bounds, passes) = {
+            let stage = read(&self.stage);
+            (
+                stage.scene.pixel_bounds,
+                stage.scene.sampler.samples_per_pixel(),
+            )
+        };
+        // The eyes' films have the view's pixel bounds: an eye differs from the rig's centre
+        // only in its pose and its screen window, not in its resolution or crop.
+        let mut films = [Film::new(bounds), Film::new(bounds)];
+        let outcome = self.pair_passes(&mut films, &eyes, passes, |pass, films| {
+            let images = [films[0].resolve(), films[1].resolve()];
+            // `shown` is never `separate`, the one layout without a single image.
+            if let Some(image) = compose_stereo(&images[0], &images[1], shown) {
+                self.publish(generation, pass, passes, image, Some((images, layout)));
+            }
+        });
+        // The view's own camera back in the scene, however the passes ended.
+        let mut stage = write(&self.stage);
+        stage.scene.camera = stage.centre.clone();
+        outcome
+    }
+
+    /// Adds passes to both eyes' `films` until `passes` are done or a change cancels them
+    /// (Ok(false)), calling `on_pass` with the passes done after each pair of passes. Each
+    /// eye's pass is a render of that one pass resumed from the eye's film, with the eye's
+    /// camera swapped into the scene.
+    fn pair_passes(
+        &self,
+        films: &mut [Film; 2],
+        eyes: &[AnyCamera; 2],
+        passes: u32,
+        on_pass: impl Fn(u32, &[Film; 2]),
+    ) -> Result<bool, ExploreError> {
+        for pass in 0..passes {
+            for (film, camera) in films.iter_mut().zip(eyes) {
+                if self.cancel.load(Ordering::SeqCst) {
+                    return Ok(false);
+                }
+                write(&self.stage).scene.camera = camera.clone();
+                let stage = read(&self.stage);
+                // `render` takes the film and gives it back with the pass added (or as it
+                // was, when cancelled); an empty film stands in meanwhile.
+                let resumed = std::mem::replace(
+                    film,
+                    Film::new(PixelRect {
+                        x0: 0,
+                        y0: 0,
+                        x1: 0,
+                        y1: 0,
+                    }),
+                );
+                let outcome = render(
+                    &stage.scene,
+                    RenderOptions {
+                        threads: self.threads,
+                        cancel: Some(&self.cancel),
+                        resume: Some((resumed, pass)),
+                        passes: Some(pass..pass + 1),
+                        ..Default::default()
+                    },
+                )
+                .map_err(threads_error)?;
+                *film = outcome.film;
+                if outcome.passes_done <= pass {
+                    return Ok(false);
+                }
+            }
+            on_pass(pass + 1, films);
+        }
+        Ok(true)
+    }
+
+    /// Makes a pass the latest frame and sends it to the pages (nothing once cancelled).
+    fn publish(
+        &self,
+        generation: u64,
+        done: u32,
+        all: u32,
+        image: Image,
+        eyes: Option<([Image; 2], StereoLayout)>,
+    ) {
+        if self.cancel.load(Ordering::SeqCst) {
+            return;
+        }
+        let png = match png_bytes(&image) {
+            Ok(p) => p,
+            Err(e) => {
+                eprintln!("obscura serve: {e}");
+                return;
+            }
+        };
+        *lock(&self.latest) = Some(Latest {
+            image,
+            eyes: eyes.map(|(images, layout)| (Arc::new(images), layout)),
+            generation,
+            passes: done,
+        });
+        {
+            let mut s = lock(&self.status);
+            if s.frame_generation != generation || s.passes_done == 0 {
+                s.first_pass = done;
+            }
+            s.frame_generation = generation;
+            s.passes_done = done;
+            s.passes = all;
+        }
+        self.frames.send_replace(Some(Frame {
+            generation,
+            pass: done,
+            passes: all,
+            png: Arc::new(png),
+        }));
+    }
+}
+
+/// The error of a render whose thread pool could not start.
+fn threads_error(e: impl std::fmt::Display) -> ExploreError {
+    ExploreError::Internal(format!("cannot start the render threads: {e}"))
 }
 
 /// Points `scene` at the view `d`: a new camera, sampler and pixel bounds; the whole scene
@@ -301,6 +526,22 @@ pub fn png_bytes(image: &Image) -> Result<Vec<u8>, ExploreError> {
 /// The camera-space depth (z at shutter open) of the first surface seen through raster
 /// position (`x`, `y`) from the lens centre: the `focal_distance` that brings it into focus.
 pub fn depth_at(scene: &RenderScene, x: f32, y: f32) -> Result<f32, ExploreError> {
+    depth_through(scene, &scene.camera, x, y)
+}
+
+/// The depth under a preview position of the view `scene` was built for: [`depth_at`],
+/// or for a stereo pair, through the eye (or the rig's centre) the position picks.
+pub(crate) fn preview_depth(scene: RenderScene, x: f32, y: f32) -> Result<f32, ExploreError> {
+    Stage::new(scene)?.depth_at(x, y)
+}
+
+/// [`depth_at`] through `camera` (one of the scene's view's cameras, of its film bounds).
+fn depth_through(
+    scene: &RenderScene,
+    camera: &AnyCamera,
+    x: f32,
+    y: f32,
+) -> Result<f32, ExploreError> {
     let b = scene.pixel_bounds;
     if !(x.is_finite() && y.is_finite())
         || x < b.x0 as f32
@@ -313,7 +554,6 @@ pub fn depth_at(scene: &RenderScene, x: f32, y: f32) -> Result<f32, ExploreError
             b.x0, b.x1, b.y0, b.y1
         )));
     }
-    let camera = &scene.camera;
     let hit = camera
         .generate_ray(&CameraSample::at(Point2::<Raster>::new(x, y)))
         .and_then(|r| scene.geometry.intersect(&r.ray))

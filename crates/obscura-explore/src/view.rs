@@ -8,18 +8,22 @@
 //! The explorer's limits (film edges, pixels, spp) hold for what it renders. A page asking
 //! for more is refused; a scene file asking for more is previewed at the limits (the film
 //! scaled down in proportion, the spp capped), the view says so in [`View::clamps`], and the
-//! saved scene file keeps the file's own values.
+//! saved scene file keeps the file's own values. A stereo pair renders two films, so its
+//! eyes' pixels count twice, and its side-by-side preview is twice as wide as one eye.
 
 use crate::error::ExploreError;
 use crate::request::{keyed, parse_keyed};
-use obscura_render::{RenderError, SceneDescription, parse_description};
+use crate::stereo::{pair_layout, shown};
+use obscura_render::{RenderError, SceneDescription, StereoLayout, parse_description};
 use serde_json::Value as Json;
 use std::path::{Path, PathBuf};
 use toml::{Table, Value as Toml};
 
-/// The largest film edge the explorer renders, in pixels.
+/// The largest edge of the image the explorer renders, in pixels (a stereo pair's side-by-side
+/// preview is twice one eye's width).
 pub const MAX_EDGE: u32 = 4096;
-/// The most pixels the explorer renders (a 2048 x 2048 film).
+/// The most pixels the explorer renders (a 2048 x 2048 film; a stereo pair's two films count
+/// together).
 pub const MAX_PIXELS: u64 = 2048 * 2048;
 /// The most samples per pixel the explorer renders.
 pub const MAX_SPP: u32 = 65_536;
@@ -221,7 +225,9 @@ impl View {
     pub fn apply(&self, change: &ViewChange) -> Result<View, ExploreError> {
         let mut doc = self.doc.clone();
         if let Some([w, h]) = change.resolution {
-            check_resolution(w, h)?;
+            // A single film's limits first, so absurd sizes never reach the parser; a stereo
+            // pair's tighter ones once the new view is known to be one (below).
+            check_resolution(w, h, Limits::of(None))?;
             let film = table_mut(&mut doc, "film");
             film.insert(
                 "resolution".into(),
@@ -272,8 +278,11 @@ impl View {
             },
             other => other,
         })?;
-        // What the page asked for is within the limits (checked above); what the file asks
-        // for is previewed at them.
+        // What the page asked for is within the limits (checked here, for a pair too); what
+        // the file asks for is previewed at them.
+        if let Some([w, h]) = change.resolution {
+            check_resolution(w, h, Limits::of_view(&description))?;
+        }
         let clamps = clamp_to_limits(&mut description);
         Ok(View {
             path: self.path.clone(),
@@ -284,23 +293,92 @@ impl View {
     }
 }
 
-/// Whether the explorer renders a `w` x `h` film.
-fn within_limits(w: u32, h: u32) -> bool {
-    w >= 1 && h >= 1 && w <= MAX_EDGE && h <= MAX_EDGE && u64::from(w) * u64::from(h) <= MAX_PIXELS
+/// The explorer's limits on one film of a view: for a stereo pair, each eye's, so that the
+/// pair's preview image and both films together stay within [`MAX_EDGE`] and [`MAX_PIXELS`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Limits {
+    /// The widest film.
+    max_width: u32,
+    /// The tallest film.
+    max_height: u32,
+    /// The most pixels in one film.
+    max_pixels: u64,
+    /// Whether the view is a stereo pair (for the messages).
+    pair: bool,
 }
 
-/// The largest film within the explorer's limits with the shape of `w` x `h` (the shorter
-/// edge follows the longer in proportion, rounded down, at least 1; an even height stays
-/// even, as the ODS camera needs); `w` x `h` itself when within them.
-fn preview_resolution(w: u32, h: u32) -> [u32; 2] {
-    if within_limits(w, h) {
+impl Limits {
+    /// The limits of a view whose stereo pair, if any, is previewed as `shown`: a single film
+    /// has all of them; each eye of a pair half the pixels (two films), and half the width when
+    /// the eyes are shown side by side (the preview is two films wide).
+    fn of(shown: Option<StereoLayout>) -> Limits {
+        let (max_width, max_pixels) = match shown {
+            None => (MAX_EDGE, MAX_PIXELS),
+            Some(StereoLayout::Anaglyph) => (MAX_EDGE, MAX_PIXELS / 2),
+            Some(StereoLayout::SideBySide | StereoLayout::Separate) => {
+                (MAX_EDGE / 2, MAX_PIXELS / 2)
+            }
+        };
+        Limits {
+            max_width,
+            max_height: MAX_EDGE,
+            max_pixels,
+            pair: shown.is_some(),
+        }
+    }
+
+    /// The limits of the view `d` renders.
+    fn of_view(d: &SceneDescription) -> Limits {
+        Limits::of(pair_layout(d).map(shown))
+    }
+
+    /// Whether the explorer renders a `w` x `h` film under these limits.
+    fn admit(&self, w: u32, h: u32) -> bool {
+        w >= 1
+            && h >= 1
+            && w <= self.max_width
+            && h <= self.max_height
+            && u64::from(w) * u64::from(h) <= self.max_pixels
+    }
+
+    /// The limits in words, for the messages.
+    fn describe(&self) -> String {
+        if self.pair {
+            format!(
+                "per eye of a stereo pair, which renders two films: width at most {}, height \
+                 at most {}, at most {} pixels (the pair's preview at most {MAX_EDGE} pixels \
+                 on an edge and {MAX_PIXELS} in all)",
+                self.max_width, self.max_height, self.max_pixels
+            )
+        } else {
+            format!("each edge at most {MAX_EDGE}, at most {MAX_PIXELS} pixels")
+        }
+    }
+}
+
+/// The largest film within `limits` with the shape of `w` x `h` (the shorter edge follows
+/// the longer in proportion, rounded down, at least 1; an even height stays even, as the ODS
+/// camera needs); `w` x `h` itself when within them.
+fn preview_resolution(w: u32, h: u32, limits: Limits) -> [u32; 2] {
+    if limits.admit(w, h) {
         return [w, h];
     }
     let (long, short) = (w.max(h), w.min(h));
     let follow = |l: u32| ((u64::from(l) * u64::from(short) / u64::from(long)) as u32).max(1);
-    // The longest edge that fits: `fits` only turns false as `l` grows, so bisect.
-    let fits = |l: u32| u64::from(l) * u64::from(follow(l)) <= MAX_PIXELS;
-    let (mut lo, mut hi) = (1, long.min(MAX_EDGE));
+    let shape = |l: u32| {
+        if w >= h {
+            [l, follow(l)]
+        } else {
+            [follow(l), l]
+        }
+    };
+    // The longest edge that fits: both edges grow with `l`, so `fits` only turns false as
+    // `l` grows; bisect. A 1 x 1 film always fits.
+    let fits = |l: u32| {
+        let [a, b] = shape(l);
+        limits.admit(a, b)
+    };
+    let (mut lo, mut hi) = (1, long);
     while lo < hi {
         let mid = lo + (hi - lo).div_ceil(2);
         if fits(mid) {
@@ -309,11 +387,7 @@ fn preview_resolution(w: u32, h: u32) -> [u32; 2] {
             hi = mid - 1;
         }
     }
-    let [pw, mut ph] = if w >= h {
-        [lo, follow(lo)]
-    } else {
-        [follow(lo), lo]
-    };
+    let [pw, mut ph] = shape(lo);
     if h.is_multiple_of(2) && !ph.is_multiple_of(2) {
         // One row less fits; one more where the film is a single row.
         ph = if ph > 1 { ph - 1 } else { 2 };
@@ -327,7 +401,8 @@ fn preview_resolution(w: u32, h: u32) -> [u32; 2] {
 fn clamp_to_limits(d: &mut SceneDescription) -> Vec<Clamp> {
     let mut clamps = Vec::new();
     let [w, h] = d.film.resolution;
-    let [pw, ph] = preview_resolution(w, h);
+    let limits = Limits::of_view(d);
+    let [pw, ph] = preview_resolution(w, h, limits);
     if [pw, ph] != [w, h] {
         // OpenCV pixel centres are at integers: raster (u + 0.5) scales.
         if let Some(k) = &mut d.camera.intrinsics {
@@ -343,9 +418,10 @@ fn clamp_to_limits(d: &mut SceneDescription) -> Vec<Clamp> {
             file: serde_json::json!([w, h]),
             rendered: serde_json::json!([pw, ph]),
             message: format!(
-                "film.resolution: the scene's {w} x {h} is previewed at {pw} x {ph}, the \
-                 explorer's limit (each edge at most {MAX_EDGE}, at most {MAX_PIXELS} pixels); \
-                 a saved scene keeps {w} x {h}"
+                "film.resolution: the scene's {w} x {h} is previewed at {pw} x {ph}{}, the \
+                 explorer's limit ({}); a saved scene keeps {w} x {h}",
+                if limits.pair { " per eye" } else { "" },
+                limits.describe()
             ),
         });
     }
@@ -366,13 +442,13 @@ fn clamp_to_limits(d: &mut SceneDescription) -> Vec<Clamp> {
 }
 
 /// Refuses films a page asks for that are too large to explore interactively.
-fn check_resolution(w: u32, h: u32) -> Result<(), ExploreError> {
-    if !within_limits(w, h) {
+fn check_resolution(w: u32, h: u32, limits: Limits) -> Result<(), ExploreError> {
+    if !limits.admit(w, h) {
         return Err(ExploreError::Refused {
             key: "film.resolution".into(),
             message: format!(
-                "{w} x {h} is outside what the explorer renders: each edge 1..={MAX_EDGE}, \
-                 at most {MAX_PIXELS} pixels"
+                "{w} x {h} is outside what the explorer renders: each edge at least 1, {}",
+                limits.describe()
             ),
         });
     }
@@ -561,8 +637,108 @@ radius = 1.0
             ((100_000, 2), [4096, 2]),
             ((100_000, 1), [4096, 1]),
         ] {
-            assert_eq!(preview_resolution(w, h), want, "{w} x {h}");
+            assert_eq!(
+                preview_resolution(w, h, Limits::of(None)),
+                want,
+                "{w} x {h}"
+            );
         }
+        // A stereo pair: each eye at most 2048 * 2048 / 2 = 2097152 pixels, and at most 2048
+        // wide when the eyes are side by side.
+        let (sbs, anaglyph) = (
+            Limits::of(Some(StereoLayout::SideBySide)),
+            Limits::of(Some(StereoLayout::Anaglyph)),
+        );
+        assert_eq!(Limits::of(Some(StereoLayout::Separate)), sbs);
+        for ((w, h), limits, want) in [
+            // 1448^2 = 2096704 fits, 1449^2 = 2099601 does not.
+            ((2048, 2048), sbs, [1448, 1448]),
+            ((2048, 2048), anaglyph, [1448, 1448]),
+            // Side by side: the width binds (2048 * 512 is only 1048576 pixels).
+            ((4096, 1024), sbs, [2048, 512]),
+            // Anaglyph: the pixels bind; 2896 * 724 = 2096704, 2897 * 724 = 2097428.
+            ((4096, 1024), anaglyph, [2896, 724]),
+            // 1931 * floor(1931 * 9 / 16) = 1931 * 1086 = 2097066; 1932 * 1086 = 2098152.
+            ((3840, 2160), sbs, [1931, 1086]),
+            // A 1080p pair fits either way.
+            ((1920, 1080), sbs, [1920, 1080]),
+            ((1920, 1080), anaglyph, [1920, 1080]),
+        ] {
+            assert_eq!(
+                preview_resolution(w, h, limits),
+                want,
+                "{w} x {h}, {limits:?}"
+            );
+        }
+    }
+
+    /// The test scene as a perspective stereo pair laid out as `layout`.
+    fn stereo_scene(resolution: [u32; 2], layout: &str) -> String {
+        format!(
+            "{}\n[camera.stereo]\nconvergence = 5.0\nlayout = \"{layout}\"\n",
+            scene_with(resolution, 4)
+        )
+    }
+
+    #[test]
+    fn a_stereo_pair_counts_twice_against_the_pixel_limit() {
+        // The file's film is previewed at the pair's limit, and says so per eye.
+        let v = View::parse(
+            Path::new("test.toml"),
+            &stereo_scene([2048, 2048], "side_by_side"),
+        )
+        .unwrap();
+        assert_eq!(v.description().film.resolution, [1448, 1448]);
+        let clamp = &v.clamps()[0];
+        assert_eq!(clamp.key, "film.resolution");
+        assert!(
+            clamp.message.contains("1448 x 1448 per eye") && clamp.message.contains("stereo"),
+            "{}",
+            clamp.message
+        );
+        // The same film without the pair is within the limits.
+        let mono = View::parse(Path::new("test.toml"), &scene_with([2048, 2048], 4)).unwrap();
+        assert!(mono.clamps().is_empty());
+        // A page asking a pair for a film whose two eyes exceed the limits is refused, also
+        // when it turns the pair on in the same change...
+        let pair =
+            View::parse(Path::new("test.toml"), &stereo_scene([64, 48], "anaglyph")).unwrap();
+        for (from, json) in [
+            (&pair, r#"{"resolution": [2048, 2048]}"#),
+            (&pair, r#"{"resolution": [1449, 1449]}"#),
+            (
+                &mono,
+                r#"{"resolution": [2048, 2048], "camera": {"stereo": {"convergence": 5}}}"#,
+            ),
+        ] {
+            let e = from.apply(&change(json)).unwrap_err();
+            assert!(matches!(e, ExploreError::Refused { .. }), "{json}: {e}");
+            assert_eq!(e.key().as_deref(), Some("film.resolution"), "{e}");
+            assert!(e.to_string().contains("stereo pair"), "{e}");
+        }
+        assert_eq!(
+            pair.apply(&change(r#"{"resolution": [1448, 1448]}"#))
+                .unwrap()
+                .description()
+                .film
+                .resolution,
+            [1448, 1448]
+        );
+        // ...side by side, a pair is at most 2048 wide per eye; an anaglyph's eyes overlap.
+        let wide = r#"{"resolution": [3000, 100]}"#;
+        assert!(pair.apply(&change(wide)).is_ok());
+        let sbs = pair
+            .apply(&change(
+                r#"{"camera": {"stereo": {"convergence": 5, "layout": "separate"}}}"#,
+            ))
+            .unwrap();
+        assert!(sbs.apply(&change(wide)).is_err());
+        // A camera change that turns a pair on over a large film previews it at the limit.
+        let turned = mono
+            .apply(&change(r#"{"camera": {"stereo": {"convergence": 5}}}"#))
+            .unwrap();
+        assert_eq!(turned.description().film.resolution, [1448, 1448]);
+        assert_eq!(turned.clamps().len(), 1);
     }
 
     #[test]
@@ -577,7 +753,7 @@ radius = 1.0
         let file = parse_description(Path::new("test.toml"), &text).unwrap();
         let v = View::parse(Path::new("test.toml"), &text).unwrap();
         let [pw, ph] = v.description().film.resolution;
-        assert_eq!([pw, ph], preview_resolution(8000, 6000));
+        assert_eq!([pw, ph], preview_resolution(8000, 6000, Limits::of(None)));
         let (sx, sy) = (pw as f32 / 8000.0, ph as f32 / 6000.0);
         let (full, preview) = (
             obscura_render::camera_of(&file).unwrap(),
@@ -623,13 +799,23 @@ radius = 1.0
             prop_assert_eq!(again.description().camera.fov, fov);
         }
 
-        /// A preview film is within the limits, as large as they allow with the file's shape,
-        /// and the file's own film when that is within them.
+        /// A preview film is within the limits (a single film's or a stereo pair's), as large
+        /// as they allow with the file's shape, and the file's own film when that is within
+        /// them.
         #[test]
-        fn preview_resolution_fits_and_keeps_the_shape(w in 1u32..200_000, h in 1u32..200_000) {
-            let [pw, ph] = preview_resolution(w, h);
-            prop_assert!(within_limits(pw, ph), "{} x {}", pw, ph);
-            if within_limits(w, h) {
+        fn preview_resolution_fits_and_keeps_the_shape(
+            w in 1u32..200_000,
+            h in 1u32..200_000,
+            pair in prop::sample::select(vec![
+                None,
+                Some(StereoLayout::SideBySide),
+                Some(StereoLayout::Anaglyph),
+            ]),
+        ) {
+            let limits = Limits::of(pair);
+            let [pw, ph] = preview_resolution(w, h, limits);
+            prop_assert!(limits.admit(pw, ph), "{} x {}", pw, ph);
+            if limits.admit(w, h) {
                 prop_assert_eq!([pw, ph], [w, h]);
             } else {
                 let (long, short, plong, pshort) =
@@ -640,11 +826,10 @@ radius = 1.0
                 // One pixel more along the longer edge would not fit (two where the longer
                 // edge is an even height, which may have given up one to stay even).
                 let next = if w < h && h % 2 == 0 { plong + 2 } else { plong + 1 };
-                let next_short = (u64::from(next) * u64::from(short) / u64::from(long)).max(1);
-                prop_assert!(
-                    next > MAX_EDGE.min(long) || u64::from(next) * next_short > MAX_PIXELS,
-                    "{} x {}", pw, ph
-                );
+                let next_short =
+                    (u64::from(next) * u64::from(short) / u64::from(long)).max(1) as u32;
+                let [nw, nh] = if w >= h { [next, next_short] } else { [next_short, next] };
+                prop_assert!(next > long || !limits.admit(nw, nh), "{} x {}", pw, ph);
             }
             if h % 2 == 0 {
                 prop_assert_eq!(ph % 2, 0);

@@ -5,7 +5,7 @@ use axum::body::{Body, to_bytes};
 use axum::http::{Request, StatusCode};
 use futures_util::{SinkExt, StreamExt};
 use obscura_explore::{Explorer, Session, View, ViewChange, router};
-use serde_json::{Value, json};
+use serde_json::{Value, Value as Json, json};
 use std::path::PathBuf;
 use std::sync::Arc;
 use tokio_tungstenite::tungstenite::Message;
@@ -673,4 +673,384 @@ async fn a_scene_file_beyond_the_limits_is_previewed_at_them_and_says_so() {
         .unwrap();
     assert_eq!(frame.passes, 65_536);
     assert_eq!(png_size(&frame.png), [2048, 2048]);
+}
+
+/// A stereo pair of a small white sphere on black, laid out as `layout`: the rig at z = 5
+/// looking along -z (fov 40 across the 48 rows), interaxial 1, convergence 10; the sphere
+/// (radius 0.5) at the origin, 5 in front of the rig. The albedo integrator makes it 1 where
+/// the sphere is and 0 elsewhere, so its centroid is sharp from few samples.
+fn stereo_text(layout: &str) -> String {
+    format!(
+        r#"
+[film]
+resolution = [64, 48]
+[sampler]
+type = "sobol"
+spp = 4
+[integrator]
+type = "albedo"
+[camera]
+eye = [0.0, 0.0, 5.0]
+target = [0.0, 0.0, 0.0]
+fov = 40.0
+[camera.stereo]
+interaxial = 1.0
+convergence = 10.0
+layout = "{layout}"
+[materials.white]
+type = "diffuse"
+reflectance = [1.0, 1.0, 1.0]
+[[shapes]]
+type = "sphere"
+center = [0.0, 0.0, 0.0]
+radius = 0.5
+material = "white"
+"#
+    )
+}
+
+fn stereo_view(layout: &str) -> View {
+    View::parse(&PathBuf::from("stereo-test.toml"), &stereo_text(layout)).unwrap()
+}
+
+/// The two eyes as `obscura render` renders a stereo scene: each eye's description from
+/// `stereo_eyes`, built and rendered to its last pass, independently of the explorer.
+fn eyes_rendered(view: &View) -> [obscura_render::Image; 2] {
+    let [left, right] = view.description().stereo_eyes().expect("a stereo pair");
+    [left, right].map(|d| {
+        let scene = obscura_render::RenderScene::build(d).unwrap();
+        obscura_render::render(&scene, Default::default())
+            .unwrap()
+            .film
+            .resolve()
+    })
+}
+
+/// The session's last frame of its first view: waits for it (no clock: the frames' channel).
+async fn finished(session: &Session) -> obscura_explore::Frame {
+    session
+        .frames()
+        .wait_for(|f| f.as_ref().is_some_and(|f| f.pass == f.passes))
+        .await
+        .unwrap()
+        .clone()
+        .unwrap()
+}
+
+/// The columns `x0..x1` of `image` as an image of their own.
+fn columns(image: &obscura_render::Image, x0: u32, x1: u32) -> obscura_render::Image {
+    obscura_render::Image {
+        width: x1 - x0,
+        height: image.height,
+        pixels: (0..image.height)
+            .flat_map(|y| (x0..x1).map(move |x| image.pixel(x, y)))
+            .collect(),
+    }
+}
+
+/// The centroid of a channel's values: (x, y) in raster units (pixel centres at + 0.5).
+fn centroid(image: &obscura_render::Image, channel: usize) -> (f64, f64) {
+    let (mut sx, mut sy, mut s) = (0.0, 0.0, 0.0);
+    for y in 0..image.height {
+        for x in 0..image.width {
+            let v = f64::from(image.pixel(x, y)[channel]);
+            sx += v * (f64::from(x) + 0.5);
+            sy += v * (f64::from(y) + 0.5);
+            s += v;
+        }
+    }
+    assert!(s > 0.0, "nothing bright in the image");
+    (sx / s, sy / s)
+}
+
+/// Where each eye sees the sphere's centre, worked by hand (docs/cameras.md, off-axis
+/// stereo): an eye at offset `e` along camera +x (left `-b/2`, right `+b/2`, `b` = 1) sees the
+/// centre, 5 in front of the rig on its axis, at screen x `s (0 - e) / 5`, and its window is
+/// shifted by `-s e / C` (`C` = 10), so relative to the window's centre it is at
+/// `-s e (1/5 - 1/10)`, with `s = 1 / tan(20 deg) = 2.7475`. A screen unit is 24 pixels (the
+/// window spans [-1, 1] over 48 rows), so the left eye sees it at raster x
+/// `32 + 24 * 2.7475 * 0.5 * 0.1 = 35.297`, the right at `28.703`: a parallax of 6.594
+/// pixels, the left image to the right of the right one (the sphere is nearer than the
+/// convergence plane). Both at raster y 24.
+const LEFT_X: f64 = 35.297;
+const RIGHT_X: f64 = 28.703;
+
+#[tokio::test]
+async fn a_side_by_side_pair_is_the_command_lines_pair_with_the_parallax_of_its_rig() {
+    let view = stereo_view("side_by_side");
+    let session = Session::start(view.clone(), Some(1)).unwrap();
+    let frame = finished(&session).await;
+    // The page's image is twice as wide: the eyes side by side.
+    assert_eq!(png_size(&frame.png), [128, 48]);
+    let (image, _, passes) = session.latest_image().unwrap();
+    assert_eq!((image.width, image.height, passes), (128, 48, 4));
+    let (left, right) = (columns(&image, 0, 64), columns(&image, 64, 128));
+
+    // The parallax the rig's geometry predicts.
+    let (lx, ly) = centroid(&left, 0);
+    let (rx, ry) = centroid(&right, 0);
+    assert!(
+        (lx - LEFT_X).abs() < 0.1 && (ly - 24.0).abs() < 0.1,
+        "left eye: sphere at ({lx:.3}, {ly:.3}), expected ({LEFT_X}, 24)"
+    );
+    assert!(
+        (rx - RIGHT_X).abs() < 0.1 && (ry - 24.0).abs() < 0.1,
+        "right eye: sphere at ({rx:.3}, {ry:.3}), expected ({RIGHT_X}, 24)"
+    );
+
+    // Pass by pass, each eye's film is exact: the halves are the command line's eyes bit for
+    // bit.
+    let [want_left, want_right] = eyes_rendered(&view);
+    assert!(
+        left == want_left,
+        "the left half is not the left eye's render"
+    );
+    assert!(
+        right == want_right,
+        "the right half is not the right eye's render"
+    );
+    let (eyes, layout, _, _) = session.latest_eyes().unwrap();
+    assert_eq!(layout, obscura_render::StereoLayout::SideBySide);
+    assert!(eyes[0] == want_left && eyes[1] == want_right);
+}
+
+#[tokio::test]
+async fn an_anaglyph_takes_red_from_the_left_eye_and_cyan_from_the_right() {
+    let view = stereo_view("anaglyph");
+    let session = Session::start(view.clone(), Some(1)).unwrap();
+    let frame = finished(&session).await;
+    assert_eq!(png_size(&frame.png), [64, 48]);
+    let (image, _, _) = session.latest_image().unwrap();
+    let [left, right] = eyes_rendered(&view);
+    for y in 0..48 {
+        for x in 0..64 {
+            let (a, l, r) = (image.pixel(x, y), left.pixel(x, y), right.pixel(x, y));
+            // Red: the left eye's luminance (Rec. 709); green and blue: the right eye's.
+            let luminance = 0.2126 * l[0] + 0.7152 * l[1] + 0.0722 * l[2];
+            assert!((a[0] - luminance).abs() < 1e-6, "({x}, {y}): {a:?} {l:?}");
+            assert_eq!([a[1], a[2]], [r[1], r[2]], "({x}, {y})");
+            assert!((a[3] - 0.5 * (l[3] + r[3])).abs() < 1e-6, "({x}, {y})");
+        }
+    }
+    // So the red image of the sphere is where the left eye sees it, the cyan where the right.
+    let (red, _) = centroid(&image, 0);
+    let (green, _) = centroid(&image, 1);
+    assert!(
+        (red - LEFT_X).abs() < 0.1 && (green - RIGHT_X).abs() < 0.1,
+        "red at {red:.3}, cyan at {green:.3}"
+    );
+}
+
+#[tokio::test]
+async fn a_stereo_pairs_api_saves_and_points_as_the_command_line_would() {
+    let x = Explorer::new(stereo_view("separate"), Some(1));
+    let (_, s) = call_json(&x, "GET", "/api/scene", "").await;
+    assert_eq!(
+        s["stereo"],
+        json!({"layout": "separate", "shown": "side_by_side", "image": [128, 48]})
+    );
+    let id = new_session(&x).await;
+    wait_status(&x, id, |s| s["passes_done"] == json!(4)).await;
+
+    // Separate: one file per eye, as `obscura render` writes NAME-left and NAME-right; the
+    // request names the eye.
+    let (status, v) = call_error(&x, "GET", &format!("/api/image.png?session={id}"), "").await;
+    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{v}");
+    assert_eq!(v["key"], json!("eye"));
+    let (status, v) = call_error(
+        &x,
+        "GET",
+        &format!("/api/image.exr?session={id}&eye=middle"),
+        "",
+    )
+    .await;
+    assert_eq!(
+        (status, &v["key"]),
+        (StatusCode::BAD_REQUEST, &json!("eye"))
+    );
+    let [left, right] = eyes_rendered(&stereo_view("separate"));
+    for (eye, image) in [("left", &left), ("right", &right)] {
+        let uri = format!("/api/image.png?session={id}&eye={eye}");
+        let response = router(x.clone())
+            .oneshot(Request::get(&uri).body(Body::empty()).unwrap())
+            .await
+            .unwrap();
+        assert_eq!(response.status(), StatusCode::OK);
+        let disposition = response.headers()["content-disposition"].to_str().unwrap();
+        assert_eq!(
+            disposition,
+            format!("attachment; filename=\"view-{eye}.png\"")
+        );
+        let png = to_bytes(response.into_body(), 1 << 26).await.unwrap();
+        assert!(
+            png.as_ref() == obscura_explore::png_bytes(image).unwrap(),
+            "the {eye} eye's PNG is not its render's"
+        );
+        let (status, exr) = call(
+            &x,
+            "GET",
+            &format!("/api/image.exr?session={id}&eye={eye}"),
+            "",
+        )
+        .await;
+        assert_eq!(status, StatusCode::OK);
+        assert_eq!(&exr[..4], &[0x76, 0x2f, 0x31, 0x01]);
+    }
+
+    // Autofocus: each half of the image is its eye's film. Either eye's ray through the
+    // sphere centre's image runs sqrt(5^2 + 0.5^2) = 5.02494 to the centre and meets the
+    // sphere 0.5 sooner, at camera z 4.52494 * 5 / 5.02494 = 4.50248.
+    let mut depths = Vec::new();
+    for px in [LEFT_X, 64.0 + RIGHT_X] {
+        let (status, v) = call_json(
+            &x,
+            "POST",
+            &format!("/api/focus?session={id}"),
+            &json!({"x": px, "y": 24.0}).to_string(),
+        )
+        .await;
+        assert_eq!(status, StatusCode::OK, "{v}");
+        depths.push(v["depth"].as_f64().unwrap());
+    }
+    assert!(
+        (depths[0] - depths[1]).abs() < 1e-4 && (depths[0] - 4.50248).abs() < 1e-3,
+        "{depths:?}"
+    );
+    // The sphere's image has a raster radius of tan(asin(0.1)) / tan(20 deg) * 24 = 6.63:
+    // 5 pixels right of the left eye's centre is on it in the left half, but in the right
+    // half it is off the right eye's image (and the centre's); past the image, nothing.
+    for (px, py) in [(64.0 + LEFT_X + 5.0, 24.0), (130.0, 24.0)] {
+        let (status, v) = call_error(
+            &x,
+            "POST",
+            &format!("/api/focus?session={id}"),
+            &json!({"x": px, "y": py}).to_string(),
+        )
+        .await;
+        assert_eq!(
+            status,
+            StatusCode::UNPROCESSABLE_ENTITY,
+            "({px}, {py}): {v}"
+        );
+    }
+    let (status, v) = call_json(
+        &x,
+        "POST",
+        &format!("/api/focus?session={id}"),
+        &json!({"x": LEFT_X + 5.0, "y": 24.0}).to_string(),
+    )
+    .await;
+    assert_eq!(status, StatusCode::OK, "{v}");
+
+    // The coordinates overlay names the eye and gives its film's raster position.
+    let (_, c) = call_json(
+        &x,
+        "GET",
+        &format!("/api/coords?session={id}&x=96&y=24"),
+        "",
+    )
+    .await;
+    assert_eq!(c["eye"], json!("right"), "{c}");
+    assert_eq!(c["raster"], json!([32.0, 24.0]), "{c}");
+    let (_, c) = call_json(&x, "GET", "/api/coords?x=24&y=16", "").await;
+    assert_eq!(c["eye"], json!("left"), "{c}");
+
+    // The post-process comparison shows the pair as the page does.
+    let (status, png) = call(
+        &x,
+        "GET",
+        &format!("/api/postprocess.png?session={id}&effect=dof"),
+        "",
+    )
+    .await;
+    assert_eq!(status, StatusCode::OK, "{}", String::from_utf8_lossy(&png));
+    assert_eq!(png_size(&png), [128, 48]);
+
+    // The saved scene keeps the pair, for `obscura render` to write as its layout says.
+    let (_, toml) = call(&x, "GET", &format!("/api/scene.toml?session={id}"), "").await;
+    let saved = View::parse(
+        &PathBuf::from("saved.toml"),
+        std::str::from_utf8(&toml).unwrap(),
+    )
+    .unwrap();
+    let stereo = saved.description().camera.stereo.unwrap();
+    assert_eq!(stereo.layout, obscura_render::StereoLayout::Separate);
+    assert_eq!(stereo.rig.convergence, 10.0);
+
+    // Side by side and anaglyph save the composed image; a single view has no eyes.
+    let (_, v) = call_json(
+        &x,
+        "POST",
+        &format!("/api/view?session={id}"),
+        r#"{"camera": {"stereo": {"interaxial": 1.0, "convergence": 10.0, "layout": "side_by_side"}}}"#,
+    )
+    .await;
+    assert_eq!(v["stereo"]["image"], json!([128, 48]), "{v}");
+    let generation = v["generation"].clone();
+    wait_status(&x, id, |s| {
+        s["frame_generation"] == generation && s["passes_done"] == json!(4)
+    })
+    .await;
+    let (status, png) = call(&x, "GET", &format!("/api/image.png?session={id}"), "").await;
+    assert_eq!(status, StatusCode::OK);
+    assert_eq!(png_size(&png), [128, 48]);
+    let (_, v) = call_json(
+        &x,
+        "POST",
+        &format!("/api/view?session={id}"),
+        r#"{"camera": {"stereo": null}}"#,
+    )
+    .await;
+    assert_eq!(v["stereo"], Json::Null, "{v}");
+    let generation = v["generation"].clone();
+    wait_status(&x, id, |s| {
+        s["frame_generation"] == generation && s["passes_done"] == json!(4)
+    })
+    .await;
+    let (status, v) = call_error(
+        &x,
+        "GET",
+        &format!("/api/image.png?session={id}&eye=left"),
+        "",
+    )
+    .await;
+    assert_eq!(
+        (status, &v["key"]),
+        (StatusCode::UNPROCESSABLE_ENTITY, &json!("eye"))
+    );
+    let (_, c) = call_json(
+        &x,
+        "GET",
+        &format!("/api/coords?session={id}&x=96&y=24"),
+        "",
+    )
+    .await;
+    assert_eq!(c["eye"], Json::Null, "{c}");
+}
+
+#[tokio::test]
+async fn a_stereo_scene_beyond_the_limits_counts_its_eyes_twice() {
+    let text =
+        stereo_text("side_by_side").replace("resolution = [64, 48]", "resolution = [2048, 2048]");
+    let x = Explorer::new(
+        View::parse(&PathBuf::from("stereo-test.toml"), &text).unwrap(),
+        Some(1),
+    );
+    let (_, s) = call_json(&x, "GET", "/api/scene", "").await;
+    // Two films of 1448 x 1448 fit in 2048 x 2048 pixels; the preview is 2896 wide.
+    assert_eq!(s["resolution"], json!([1448, 1448]), "{s}");
+    assert_eq!(s["stereo"]["image"], json!([2896, 1448]), "{s}");
+    assert_eq!(s["clamped"][0]["key"], json!("film.resolution"), "{s}");
+    assert!(
+        s["clamped"][0]["message"]
+            .as_str()
+            .unwrap()
+            .contains("per eye"),
+        "{s}"
+    );
+    let (status, v) = call_error(&x, "POST", "/api/view", r#"{"resolution": [1449, 1449]}"#).await;
+    assert_eq!(
+        (status, &v["key"]),
+        (StatusCode::UNPROCESSABLE_ENTITY, &json!("film.resolution"))
+    );
 }
