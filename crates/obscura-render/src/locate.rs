@@ -1,90 +1,141 @@
 //! Finding the line of a key in a TOML scene file, for error messages.
 //!
 //! Serde reports byte spans for syntax and type errors; checks made after parsing (a fov out of
-//! range, an undefined material) know only the key's path. This module maps both to a line, by
-//! reading the file the way a person does: table headers, then `key =` lines below them.
+//! range, an undefined material) know only the key's path. This module maps both to a line
+//! through toml's own parse of the file with spans (recovering what it can of a file with a
+//! syntax error), so multi-line arrays, inline tables and dotted keys are read as the parser
+//! reads them.
+
+use toml::Spanned;
+use toml::de::{DeTable, DeValue};
 
 /// The 1-based line holding byte offset `at`.
 pub(crate) fn line_of_offset(source: &str, at: usize) -> usize {
-    source[..at.min(source.len())]
-        .bytes()
-        .filter(|&b| b == b'\n')
+    // Bytes, not a `str` slice: a span from a recovered parse need not fall on a character.
+    source.as_bytes()[..at.min(source.len())]
+        .iter()
+        .filter(|&&b| b == b'\n')
         .count()
         + 1
 }
 
-/// The table header in force at each line: `camera`, `shapes[2]`, `materials.white`, or "".
-fn headers(source: &str) -> Vec<(usize, String)> {
-    let mut counts: std::collections::HashMap<String, usize> = Default::default();
-    let mut current = String::new();
+/// One step of a key path: a table's key, or an array's index.
+enum Step<'a> {
+    Key(&'a str),
+    Index(usize),
+}
+
+/// The steps of a path such as `shapes[2].transform[0]`.
+fn steps(path: &str) -> Vec<Step<'_>> {
     let mut out = Vec::new();
-    for (i, line) in source.lines().enumerate() {
-        let t = line.trim();
-        if let Some(name) = t.strip_prefix("[[").and_then(|r| r.split("]]").next()) {
-            let name = name.trim().to_string();
-            let n = counts.entry(name.clone()).or_insert(0);
-            current = format!("{name}[{n}]");
-            *n += 1;
-        } else if let Some(name) = t.strip_prefix('[').and_then(|r| r.split(']').next()) {
-            current = name.trim().to_string();
+    for part in path.split('.') {
+        let (name, mut rest) = part.split_once('[').map_or((part, ""), |(n, r)| (n, r));
+        out.push(Step::Key(name));
+        while let Some((index, after)) = rest.split_once(']') {
+            if let Ok(i) = index.parse() {
+                out.push(Step::Index(i));
+            }
+            rest = after.strip_prefix('[').unwrap_or("");
         }
-        out.push((i + 1, current.clone()));
     }
     out
 }
 
-/// The key written on a `key = value` line, if it is one.
-fn key_on(line: &str) -> Option<&str> {
-    let t = line.trim();
-    if t.starts_with('[') || t.starts_with('#') {
-        return None;
-    }
-    let (key, _) = t.split_once('=')?;
-    Some(key.trim().trim_matches('"'))
-}
-
 /// The line where `path` (e.g. `camera.fov`, `shapes[2].transform[0]`) is written: the key's
-/// own line when found, else its table's header line.
+/// own line when found, else the line of the nearest enclosing key or table that is (a
+/// table's header for a key missing from it).
 pub(crate) fn line_of_key(source: &str, path: &str) -> Option<usize> {
-    let lines: Vec<&str> = source.lines().collect();
-    let mut header_line = None;
-    // The table's own header beats an enclosing one's (`[camera.stereo]` over `[camera]` for
-    // the key `camera.stereo`).
-    let mut own_header_line = None;
-    for (n, header) in headers(source) {
-        let rest = if header.is_empty() {
-            Some(path)
-        } else if path == header {
-            own_header_line = own_header_line.or(Some(n));
-            None
-        } else {
-            path.strip_prefix(header.as_str())
-                .and_then(|r| r.strip_prefix('.'))
+    let (root, _) = DeTable::parse_recoverable(source);
+    let mut table = Some(root.get_ref());
+    let mut value: Option<&Spanned<DeValue<'_>>> = None;
+    let mut line = None;
+    for step in steps(path) {
+        // Where the step is written (a key's own span, an element's start) and its value.
+        let found = match step {
+            Step::Key(key) => table
+                .and_then(|t| t.iter().find(|(k, _)| k.get_ref() == key))
+                .map(|(k, v)| (k.span().start, v)),
+            Step::Index(i) => match value.map(Spanned::get_ref) {
+                Some(DeValue::Array(a)) => a.get(i).map(|v| (v.span().start, v)),
+                _ => None,
+            },
         };
-        let Some(rest) = rest else { continue };
-        // The innermost enclosing table's header: `[camera.stereo]` over `[camera]`.
-        if !header.is_empty() && header_line.is_none_or(|(len, _)| header.len() > len) {
-            header_line = Some((header.len(), n));
-        }
-        // The first segment of the rest, without an index: `transform[0].rotate` -> `transform`.
-        let first = rest.split(['.', '[']).next().unwrap_or(rest);
-        if key_on(lines[n - 1]) == Some(first) {
-            return Some(n);
-        }
+        let Some((at, v)) = found else { break };
+        line = Some(line_of_offset(source, at));
+        table = match v.get_ref() {
+            DeValue::Table(t) => Some(t),
+            _ => None,
+        };
+        value = Some(v);
     }
-    own_header_line.or(header_line.map(|(_, n)| n))
+    line
 }
 
-/// The key path of the `key = value` line at `line`, qualified by its table: for serde errors,
-/// which carry a span but no key.
+/// The key path written on line `line` (the key of a `key = value` line, qualified by its
+/// table, or a table's header), or else the innermost key whose value spans that line: for
+/// serde errors, which carry a span but no key.
 pub(crate) fn key_at_line(source: &str, line: usize) -> Option<String> {
-    let (_, header) = headers(source).into_iter().find(|(n, _)| *n == line)?;
-    let text = source.lines().nth(line - 1)?;
-    match key_on(text) {
-        Some(key) if header.is_empty() => Some(key.to_string()),
-        Some(key) => Some(format!("{header}.{key}")),
-        None if !header.is_empty() => Some(header),
-        None => None,
+    let (root, _) = DeTable::parse_recoverable(source);
+    let mut on_line = None;
+    let mut around = None;
+    visit(source, root.get_ref(), "", line, &mut on_line, &mut around);
+    on_line.or(around)
+}
+
+/// Walks `table` under `prefix`, keeping the last key written on `line` and the last (so the
+/// innermost) whose value's lines hold it.
+fn visit(
+    source: &str,
+    table: &DeTable<'_>,
+    prefix: &str,
+    line: usize,
+    on_line: &mut Option<String>,
+    around: &mut Option<String>,
+) {
+    for (key, value) in table {
+        let path = if prefix.is_empty() {
+            key.get_ref().to_string()
+        } else {
+            format!("{prefix}.{}", key.get_ref())
+        };
+        if line_of_offset(source, key.span().start) == line {
+            *on_line = Some(path.clone());
+        }
+        visit_value(source, value, &path, line, on_line, around);
+    }
+}
+
+/// [`visit`] for a value: tables are walked, arrays' elements named by index.
+fn visit_value(
+    source: &str,
+    value: &Spanned<DeValue<'_>>,
+    path: &str,
+    line: usize,
+    on_line: &mut Option<String>,
+    around: &mut Option<String>,
+) {
+    let span = value.span();
+    let (first, last) = (
+        line_of_offset(source, span.start),
+        line_of_offset(source, span.end.saturating_sub(1).max(span.start)),
+    );
+    if (first..=last).contains(&line) {
+        *around = Some(path.to_string());
+    }
+    match value.get_ref() {
+        DeValue::Table(t) => visit(source, t, path, line, on_line, around),
+        DeValue::Array(a) => {
+            for (i, element) in a.iter().enumerate() {
+                let path = format!("{path}[{i}]");
+                if let DeValue::Table(_) = element.get_ref()
+                    && line_of_offset(source, element.span().start) == line
+                {
+                    *on_line = Some(path.clone());
+                }
+                visit_value(source, element, &path, line, on_line, around);
+            }
+        }
+        _ => {}
     }
 }
 
@@ -111,6 +162,36 @@ mod tests {
         assert_eq!(line_of_key(nested, "camera.stereo"), Some(3));
         assert_eq!(line_of_key(nested, "camera.stereo.interaxial"), Some(4));
         assert_eq!(line_of_key(nested, "camera.stereo.layout"), Some(3));
+    }
+
+    /// Rows of a multi-line array that begin with `[` are not table headers, a `[camera]` inside
+    /// a multi-line string is text, and a dotted key or an inline table is found where the
+    /// parser finds it. (A line-by-line reading took the array's rows for headers: `fov` was
+    /// reported at the `[camera]` line, and its key as `1.0, 1.0.fov`.)
+    #[test]
+    fn arrays_strings_and_inline_tables_are_read_as_toml() {
+        let scene = "[camera]\nshutter_curve = [\n  [0.0, 0.0],\n  [0.5, 1.0],\n  [1.0, 1.0],\n]\n\
+                     fov = 180.0\nrolling_shutter = { readout = 2.0, direction = \"up\" }\n\
+                     [integrator]\nnote = \"\"\"\n[camera]\nfov = 3\n\"\"\"\nstereo.interaxial = 1\n";
+        assert_eq!(line_of_key(scene, "camera.fov"), Some(7));
+        assert_eq!(line_of_key(scene, "camera.shutter_curve[1]"), Some(4));
+        assert_eq!(
+            line_of_key(scene, "camera.rolling_shutter.direction"),
+            Some(8)
+        );
+        assert_eq!(line_of_key(scene, "integrator.stereo.interaxial"), Some(14));
+        assert_eq!(key_at_line(scene, 7).as_deref(), Some("camera.fov"));
+        assert_eq!(
+            key_at_line(scene, 4).as_deref(),
+            Some("camera.shutter_curve[1][1]"),
+            "the innermost value on a row of the array"
+        );
+        assert_eq!(
+            key_at_line(scene, 11).as_deref(),
+            Some("integrator.note"),
+            "inside a string"
+        );
+        assert_eq!(key_at_line(scene, 9).as_deref(), Some("integrator"));
     }
 
     #[test]
