@@ -34,9 +34,29 @@ pub(crate) struct CameraIr {
     pub(crate) shutter: [f32; 2],
     pub(crate) near: Option<f32>,
     pub(crate) far: Option<f32>,
-    /// A lens system (pbrt's `realistic`): the lens file's path, resolved against the scene
-    /// file's folder, and `aperture_diameter`, `focus_distance`, `film_diagonal`.
-    pub(crate) realistic: Option<(std::path::PathBuf, f32, f32, f32)>,
+    /// A lens system (pbrt's `realistic`).
+    pub(crate) realistic: Option<RealisticIr>,
+}
+
+/// A lens system's keys.
+#[derive(Clone, Debug)]
+pub(crate) struct RealisticIr {
+    /// The lens file's path, resolved against the scene file's folder.
+    pub(crate) lens_file: std::path::PathBuf,
+    pub(crate) aperture_diameter: f32,
+    pub(crate) focus_distance: f32,
+    pub(crate) film_diagonal: f32,
+    /// The stop's shape when not round.
+    pub(crate) stop: Option<StopIr>,
+}
+
+/// A stop's shape other than round.
+#[derive(Clone, Debug)]
+pub(crate) enum StopIr {
+    /// `aperture_blades`, `aperture_rotation` (degrees).
+    Blades(u32, f32),
+    /// `aperture_image`, resolved against the scene file's folder.
+    Image(std::path::PathBuf),
 }
 
 /// A material in the scene format's terms.
@@ -554,11 +574,19 @@ fn emit(ir: &Ir, mesh_dir: &str, base: &Path, source: &Path) -> Result<Emitted, 
     if let Some(f) = camera.focal_distance {
         let _ = writeln!(out, "focal_distance = {}", num(f));
     }
-    if let Some((file, aperture, focus, diagonal)) = &camera.realistic {
-        name_file(&mut out, "lens_file", file);
-        let _ = writeln!(out, "aperture_diameter = {}", num(*aperture));
-        let _ = writeln!(out, "focus_distance = {}", num(*focus));
-        let _ = writeln!(out, "film_diagonal = {}", num(*diagonal));
+    if let Some(r) = &camera.realistic {
+        name_file(&mut out, "lens_file", &r.lens_file);
+        let _ = writeln!(out, "aperture_diameter = {}", num(r.aperture_diameter));
+        let _ = writeln!(out, "focus_distance = {}", num(r.focus_distance));
+        let _ = writeln!(out, "film_diagonal = {}", num(r.film_diagonal));
+        match &r.stop {
+            Some(StopIr::Blades(blades, rotation)) => {
+                let _ = writeln!(out, "aperture_blades = {blades}");
+                let _ = writeln!(out, "aperture_rotation = {}", num(*rotation));
+            }
+            Some(StopIr::Image(file)) => name_file(&mut out, "aperture_image", file),
+            None => {}
+        }
     }
     if let Some(n) = camera.near {
         let _ = writeln!(out, "near = {}", num(n));

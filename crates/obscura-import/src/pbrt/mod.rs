@@ -12,7 +12,9 @@ mod lexer;
 mod params;
 
 use crate::error::{ImportError, Location};
-use crate::scene::{CameraIr, FilmIr, GeometryIr, Imported, Ir, LightIr, MaterialIr, ShapeIr};
+use crate::scene::{
+    CameraIr, FilmIr, GeometryIr, Imported, Ir, LightIr, MaterialIr, RealisticIr, ShapeIr, StopIr,
+};
 use glam::{DMat4, DVec3, Vec2, Vec3};
 use lexer::{Kind, Token};
 use obscura_accel::TriangleMesh;
@@ -669,6 +671,59 @@ impl Pbrt {
     fn resolve(&self, name: &str) -> PathBuf {
         let base = self.main.parent().unwrap_or(Path::new(""));
         base.join(name)
+    }
+
+    /// pbrt-v4's realistic `aperture` as the scene format's stop. pbrt scales every aperture
+    /// image to pass the round stop's light; Obscura's realistic camera makes the film's
+    /// centre see the scene's radiance whatever the stop's shape, so the light needs nothing.
+    ///
+    /// pbrt draws its built-in shapes into an image over the stop's square and flips it
+    /// vertically before use, so a shape drawn with a vertex up has it at lens -y:
+    /// - `"square"`: the middle half of the square, side r for stop radius r: the polygon of
+    ///   4 blades at 45 degrees on the circle of radius r / sqrt(2);
+    /// - `"pentagon"`: the regular pentagon on the circle of radius 0.8 r, a vertex at lens
+    ///   -y (rotation 270 degrees);
+    /// - an image file: the stop's `aperture_image` (read as luminance where pbrt averages
+    ///   the channels: the same for a grey image);
+    /// - `"gaussian"` and `"star"` have no polygon and no file: a warning, and the round stop.
+    ///
+    /// The polygons scale `aperture_diameter` to their circles.
+    fn stop(
+        &mut self,
+        name: &str,
+        loc: &Location,
+        aperture_diameter: &mut f32,
+    ) -> Result<Option<StopIr>, ImportError> {
+        Ok(match name {
+            "" => None,
+            "square" => {
+                *aperture_diameter *= std::f32::consts::FRAC_1_SQRT_2;
+                Some(StopIr::Blades(4, 45.0))
+            }
+            "pentagon" => {
+                *aperture_diameter *= 0.8;
+                Some(StopIr::Blades(5, 270.0))
+            }
+            "gaussian" | "star" => {
+                self.ir.warn(
+                    loc,
+                    format!(
+                        "Camera \"realistic\": \"string aperture\" \"{name}\" is not carried over; the stop stays round"
+                    ),
+                );
+                None
+            }
+            file => {
+                let path = self.resolve(file);
+                if !path.is_file() {
+                    return Err(loc.error(format!(
+                        "Camera \"realistic\": \"string aperture\": no image file {}",
+                        path.display()
+                    )));
+                }
+                Some(StopIr::Image(path))
+            }
+        })
     }
 
     fn sampler(&mut self, kind: &str, p: &Params, loc: &Location) -> Result<(), ImportError> {
@@ -1475,17 +1530,23 @@ impl Pbrt {
             "realistic" => {
                 // pbrt-v4's parameters and defaults: lensfile (relative to the main scene
                 // file's folder, as pbrt resolves every file name), aperturediameter 1 mm,
-                // focusdistance 10; the film's diagonal (35 mm).
+                // focusdistance 10; the film's diagonal (35 mm); aperture (round when absent).
                 let Some(file) = p.string("lensfile")? else {
                     return Err(loc.error("Camera \"realistic\": \"string lensfile\" is required"));
                 };
                 cam.kind = "realistic";
-                cam.realistic = Some((
-                    self.resolve(&file),
-                    p.num_or("aperturediameter", 1.0)? as f32,
-                    p.num_or("focusdistance", 10.0)? as f32,
-                    film_diagonal as f32,
-                ));
+                let mut aperture_diameter = p.num_or("aperturediameter", 1.0)? as f32;
+                let stop = match p.string("aperture")? {
+                    None => None,
+                    Some(name) => self.stop(&name, &loc, &mut aperture_diameter)?,
+                };
+                cam.realistic = Some(RealisticIr {
+                    lens_file: self.resolve(&file),
+                    aperture_diameter,
+                    focus_distance: p.num_or("focusdistance", 10.0)? as f32,
+                    film_diagonal: film_diagonal as f32,
+                    stop,
+                });
             }
             other => {
                 return Err(loc.error(format!(
