@@ -828,12 +828,19 @@ fn image_infinite_lights_keep_pbrts_equal_area_orientation() {
     assert_eq!(converted.pixels, image.pixels);
 }
 
-#[test]
-fn the_realistic_camera_takes_pbrts_parameters_and_defaults() {
-    let dir = scratch("pbrt-realistic");
+/// A scratch folder holding `lenses/dgauss.dat` (the shipped double-Gauss 50 mm), as a pbrt
+/// scene beside it names its lens file.
+fn lens_scratch(name: &str) -> std::path::PathBuf {
+    let dir = scratch(name);
     let lens = include_str!("../../../../scenes/lenses/double-gauss-50mm.dat");
     std::fs::create_dir_all(dir.join("lenses")).unwrap();
     write(&dir.join("lenses"), "dgauss.dat", lens);
+    dir
+}
+
+#[test]
+fn the_realistic_camera_takes_pbrts_parameters_and_defaults() {
+    let dir = lens_scratch("pbrt-realistic");
     let scene = "LookAt 0 0 5  0 0 0  0 1 0\n\
                  Camera \"realistic\" \"string lensfile\" \"lenses/dgauss.dat\" \
                  \"float aperturediameter\" 6 \"float focusdistance\" 5\n\
@@ -881,10 +888,7 @@ fn the_realistic_camera_takes_pbrts_parameters_and_defaults() {
 #[test]
 fn pbrts_aperture_shapes_map_onto_the_stop() {
     use obscura_camera::ApertureShape;
-    let dir = scratch("pbrt-aperture");
-    let lens = include_str!("../../../../scenes/lenses/double-gauss-50mm.dat");
-    std::fs::create_dir_all(dir.join("lenses")).unwrap();
-    write(&dir.join("lenses"), "dgauss.dat", lens);
+    let dir = lens_scratch("pbrt-aperture");
     // The middle half of the square white, the rest black: pbrt's "square" drawn as a file.
     let mut pixels = vec![[0.0, 0.0, 0.0, 1.0]; 64 * 64];
     for y in 16..48 {
@@ -971,10 +975,7 @@ fn pbrts_aperture_shapes_map_onto_the_stop() {
 /// transmission at the centre, which is 1 only to within its glass's geometry.
 #[test]
 fn a_pbrt_aperture_shape_passes_the_round_stops_light() {
-    let dir = scratch("pbrt-aperture-light");
-    let lens = include_str!("../../../../scenes/lenses/double-gauss-50mm.dat");
-    std::fs::create_dir_all(dir.join("lenses")).unwrap();
-    write(&dir.join("lenses"), "dgauss.dat", lens);
+    let dir = lens_scratch("pbrt-aperture-light");
     let centre = |aperture: &str| {
         let scene = format!(
             "Camera \"realistic\" \"string lensfile\" \"lenses/dgauss.dat\" \
