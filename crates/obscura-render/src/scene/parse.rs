@@ -760,4 +760,44 @@ mod tests {
             assert_eq!(line, Some(line_of(&text, at)), "{bad}: {message}");
         }
     }
+
+    /// A table given as another kind of value says it wants a table, in the scene format's
+    /// words: no Rust struct's name (`expected struct RawFilm`) in the message.
+    #[test]
+    fn a_value_where_a_table_belongs_asks_for_a_table() {
+        let body = "[[shapes]]\ntype = \"sphere\"\nradius = 1.0\n";
+        for (bad, key) in [
+            (
+                format!("film = 3\n[camera]\ntype = \"perspective\"\n{body}"),
+                "film",
+            ),
+            (format!("sampler = 5\n{CAMERA}{body}"), "sampler"),
+            (
+                format!("integrator = \"path\"\n{CAMERA}{body}"),
+                "integrator",
+            ),
+            (
+                format!("{CAMERA}rolling_shutter = 3\n{body}"),
+                "camera.rolling_shutter",
+            ),
+            (format!("{CAMERA}stereo = [1]\n{body}"), "camera.stereo"),
+            (
+                format!("{CAMERA}{body}transform = [5]\n"),
+                "shapes[0].transform",
+            ),
+            (format!("{CAMERA}[materials]\nm = 3\n{body}"), "materials.m"),
+            (format!("lights = [7]\n{CAMERA}{body}"), "lights"),
+        ] {
+            let e = parse_description(Path::new("s.toml"), &bad).expect_err(&bad);
+            let text = e.to_string();
+            assert!(
+                text.contains("expected a table") && !text.contains("Raw"),
+                "{bad}: {text}"
+            );
+            let RenderError::Scene { key: Some(k), .. } = &e else {
+                panic!("{bad}: no key in {e:?}");
+            };
+            assert!(k.starts_with(key), "{bad}: key {k}, want {key}");
+        }
+    }
 }

@@ -6,7 +6,7 @@ use serde::Deserialize;
 use std::collections::BTreeMap;
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "a scene file of tables")]
 pub(super) struct RawScene {
     pub(super) film: RawFilm,
     #[serde(default)]
@@ -26,6 +26,7 @@ pub(super) struct RawScene {
 /// tables outside them are skipped, not denied (serde's default), so that a scene the renderer
 /// refuses elsewhere still gives its camera; the tables read keep their `deny_unknown_fields`.
 #[derive(Deserialize)]
+#[serde(expecting = "a scene file of tables")]
 pub(super) struct RawCameraPart {
     pub(super) film: RawFilm,
     #[serde(default)]
@@ -43,7 +44,7 @@ pub(super) struct RawSamplerType {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "a table")]
 pub(super) struct RawFilm {
     #[serde(deserialize_with = "fixed::exact")]
     pub(super) resolution: [u32; 2],
@@ -53,7 +54,7 @@ pub(super) struct RawFilm {
 }
 
 #[derive(Deserialize, Default)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "a table")]
 pub(super) struct RawSampler {
     #[serde(rename = "type")]
     pub(super) kind: Option<String>,
@@ -62,7 +63,7 @@ pub(super) struct RawSampler {
 }
 
 #[derive(Deserialize, Default)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "a table")]
 pub(super) struct RawIntegrator {
     #[serde(rename = "type")]
     pub(super) kind: Option<String>,
@@ -70,7 +71,7 @@ pub(super) struct RawIntegrator {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "a table")]
 pub(super) struct RawCamera {
     #[serde(rename = "type")]
     pub(super) kind: Option<String>,
@@ -135,14 +136,17 @@ pub(super) struct RawCamera {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "a table such as { readout = 0.5, direction = \"top_to_bottom\" }"
+)]
 pub(super) struct RawRollingShutter {
     pub(super) readout: Option<f32>,
     pub(super) direction: Option<String>,
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "a table")]
 pub(super) struct RawStereo {
     pub(super) interaxial: Option<f32>,
     pub(super) convergence: Option<f32>,
@@ -150,7 +154,7 @@ pub(super) struct RawStereo {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "a table")]
 pub(super) struct RawMaterial {
     #[serde(rename = "type")]
     pub(super) kind: String,
@@ -161,7 +165,7 @@ pub(super) struct RawMaterial {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "a table")]
 pub(super) struct RawShape {
     #[serde(rename = "type")]
     pub(super) kind: String,
@@ -183,7 +187,10 @@ pub(super) struct RawShape {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "a table such as { translate = [0, 1, 0] }"
+)]
 pub(super) struct RawOp {
     #[serde(default, deserialize_with = "fixed::optional")]
     pub(super) scale: Option<V3>,
@@ -196,7 +203,7 @@ pub(super) struct RawOp {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "a table")]
 pub(super) struct RawLight {
     #[serde(rename = "type")]
     pub(super) kind: String,
