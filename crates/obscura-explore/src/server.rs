@@ -379,28 +379,15 @@ fn attachment(name: &str) -> String {
     format!("attachment; filename=\"{name}\"")
 }
 
-async fn image_png(State(x): Api, q: Params) -> Result<Response, ExploreError> {
-    let (image, _, stem) = latest(&x, &q)?;
-    let png = blocking(move || png_bytes(&image)).await?;
-    Ok((
-        [
-            (header::CONTENT_TYPE, "image/png".to_string()),
-            (
-                header::CONTENT_DISPOSITION,
-                attachment(&format!("{stem}.png")),
-            ),
-        ],
-        png,
-    )
-        .into_response())
-}
-
-async fn image_exr(State(x): Api, q: Params) -> Result<Response, ExploreError> {
-    let (image, passes, stem) = latest(&x, &q)?;
-    let exr = blocking(move || {
-        // The EXR writer writes files; a private temporary one, read back and removed.
+/// The latest frame as `obscura render` writes it to a file of extension `ext` (`png` or
+/// `exr`): the same encoder, so a download is the command line's file byte for byte (the
+/// PNG keeps the film's coverage as alpha, which the page's opaque preview frames drop).
+async fn image_file(x: &Explorer, q: &Params, ext: &'static str) -> Result<Response, ExploreError> {
+    let (image, passes, stem) = latest(x, q)?;
+    let bytes = blocking(move || {
+        // The writer writes files; a private temporary one, read back and removed.
         let path = std::env::temp_dir().join(format!(
-            "obscura-explore-{}-{}.exr",
+            "obscura-explore-{}-{}.{ext}",
             std::process::id(),
             TEMP_COUNTER.fetch_add(1, Ordering::SeqCst)
         ));
@@ -419,17 +406,30 @@ async fn image_exr(State(x): Api, q: Params) -> Result<Response, ExploreError> {
         Ok(written?)
     })
     .await?;
+    let kind = if ext == "png" {
+        "image/png"
+    } else {
+        "image/x-exr"
+    };
     Ok((
         [
-            (header::CONTENT_TYPE, "image/x-exr".to_string()),
+            (header::CONTENT_TYPE, kind.to_string()),
             (
                 header::CONTENT_DISPOSITION,
-                attachment(&format!("{stem}.exr")),
+                attachment(&format!("{stem}.{ext}")),
             ),
         ],
-        exr,
+        bytes,
     )
         .into_response())
+}
+
+async fn image_png(State(x): Api, q: Params) -> Result<Response, ExploreError> {
+    image_file(&x, &q, "png").await
+}
+
+async fn image_exr(State(x): Api, q: Params) -> Result<Response, ExploreError> {
+    image_file(&x, &q, "exr").await
 }
 
 static TEMP_COUNTER: AtomicU64 = AtomicU64::new(0);

@@ -66,6 +66,20 @@ async fn call(x: &Arc<Explorer>, method: &str, uri: &str, body: &str) -> (Status
 
 /// An answer that must be an error in the documented form: JSON `{"error": MESSAGE, "key":
 /// KEY-or-null}` with a message; its status and body.
+/// The PNG file `obscura render` writes of `image` (the renderer's own writer).
+fn cli_png(image: &obscura_render::Image) -> Vec<u8> {
+    let path =
+        std::env::temp_dir().join(format!("obscura-explore-test-{}.png", std::process::id()));
+    let info = obscura_render::ImageInfo {
+        partial: false,
+        samples_per_pixel: 1,
+    };
+    obscura_render::write_image(&path, image, &info).unwrap();
+    let bytes = std::fs::read(&path).unwrap();
+    let _ = std::fs::remove_file(&path);
+    bytes
+}
+
 async fn call_error(x: &Arc<Explorer>, method: &str, uri: &str, body: &str) -> (StatusCode, Value) {
     let request = Request::builder()
         .method(method)
@@ -883,8 +897,8 @@ async fn a_stereo_pairs_api_saves_and_points_as_the_command_line_would() {
         );
         let png = to_bytes(response.into_body(), 1 << 26).await.unwrap();
         assert!(
-            png.as_ref() == obscura_explore::png_bytes(image).unwrap(),
-            "the {eye} eye's PNG is not its render's"
+            png.as_ref() == cli_png(image),
+            "the {eye} eye's PNG is not the file `obscura render` writes of its render"
         );
         let (status, exr) = call(
             &x,
