@@ -301,13 +301,17 @@ async fn coords(State(x): Api, q: Params) -> Result<Response, ExploreError> {
     let view = x.view_of(q.session()?)?;
     let d = view.description();
     let centre = camera_of(d)?;
+    // The page's image starts at the crop window's first pixel, the film's raster at the
+    // full film's.
+    let [x0, x1, y0, _] = Camera::film(&centre).pixel_bounds();
+    let (dx, dy) = (x0 as f32, y0 as f32);
     let Some(layout) = pair_layout(d) else {
-        let mut c = coordinates(&centre, px, py);
+        let mut c = coordinates(&centre, px + dx, py + dy);
         c["eye"] = Json::Null;
         return Ok(axum::Json(c).into_response());
     };
-    let [x0, x1, _, _] = Camera::film(&centre).pixel_bounds();
     let Pick { eye, x: ex, y: ey } = pick(Some(shown(layout)), x1 - x0, px, py);
+    let (ex, ey) = (ex + dx, ey + dy);
     let (camera, name) = match (eye, d.stereo_eyes()) {
         (Some(eye), Some([left, right])) => {
             let eye_d = if eye == StereoEye::Left { left } else { right };

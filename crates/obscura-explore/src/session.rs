@@ -109,10 +109,13 @@ impl Stage {
     /// The camera-space depth of the first surface under preview position (`x`, `y`): a
     /// stereo pair's preview position picks the eye ([`pick`]).
     fn depth_at(&self, x: f32, y: f32) -> Result<f32, ExploreError> {
-        let Some((eyes, layout)) = &self.pair else {
-            return depth_through(&self.scene, &self.centre, x, y);
-        };
+        // The page's image starts at the crop window's first pixel, the film's raster at the
+        // full film's.
         let b = self.scene.pixel_bounds;
+        let (x0, y0) = (b.x0 as f32, b.y0 as f32);
+        let Some((eyes, layout)) = &self.pair else {
+            return depth_through(&self.scene, &self.centre, x + x0, y + y0);
+        };
         let (w, h) = (b.x1 - b.x0, b.y1 - b.y0);
         let preview_w = match layout {
             StereoLayout::Anaglyph => w,
@@ -134,7 +137,7 @@ impl Stage {
             Some(StereoEye::Left) => &eyes[0],
             Some(StereoEye::Right) => &eyes[1],
         };
-        depth_through(&self.scene, camera, x, y)
+        depth_through(&self.scene, camera, x + x0, y + y0)
     }
 }
 

@@ -350,6 +350,51 @@ async fn coordinates_follow_the_space_conventions() {
     assert!(f(&p["screen"][0]) < 0.0 && f(&p["screen"][1]) > 0.0, "{c}");
 }
 
+/// With a crop window the page's image starts at the window's first pixel: a position in it
+/// is that much further into the film. The scene's film is 48 x 32 and the window its lower
+/// right quarter, so the image's (0.5, 0.5) is raster (24.5, 16.5), half a pixel off the
+/// film's centre. A pixel there spans 2 tan(20 deg) / 32 = 0.022748 on the plane z = 1, so the
+/// ray is (0.011374, -0.011374, -1) from the eye at z = 5; it meets the unit sphere at the
+/// origin where (5 - t)^2 + t^2 s = 1, s = 2 (0.011374)^2 = 0.00025874:
+/// t = (10 - sqrt(4 - 96 s)) / (2 (1 + s)) = 4.002075, the depth. The image's (22.5, 14.5) is
+/// raster (46.5, 30.5), on the wall at z = -2: depth 7 for any ray. Without the offset, the
+/// first position is raster (0.5, 0.5), off the crop window.
+#[tokio::test]
+async fn a_cropped_views_positions_are_offset_into_the_film() {
+    let text = scene_text(1).replace(
+        "resolution = [48, 32]",
+        "resolution = [48, 32]\ncrop = [0.5, 1.0, 0.5, 1.0]",
+    );
+    let view = View::parse(&PathBuf::from("explore-test.toml"), &text).unwrap();
+    let x = Explorer::new(view, Some(1));
+    let id = new_session(&x).await;
+    wait_status(&x, id, |s| s["passes_done"] == json!(1)).await;
+    let (status, c) = call_json(
+        &x,
+        "GET",
+        &format!("/api/coords?session={id}&x=1.5&y=2.5"),
+        "",
+    )
+    .await;
+    assert_eq!(status, StatusCode::OK, "{c}");
+    assert_eq!(c["raster"], json!([25.5, 18.5]), "{c}");
+    for ((px, py), depth) in [((0.5, 0.5), 4.002075), ((22.5, 14.5), 7.0)] {
+        let (status, v) = call_json(
+            &x,
+            "POST",
+            &format!("/api/focus?session={id}"),
+            &json!({"x": px, "y": py}).to_string(),
+        )
+        .await;
+        assert_eq!(status, StatusCode::OK, "({px}, {py}): {v}");
+        let got = v["depth"].as_f64().unwrap();
+        assert!(
+            (got - depth).abs() < 1e-4,
+            "({px}, {py}): depth {got}, expected {depth}"
+        );
+    }
+}
+
 #[tokio::test]
 async fn a_session_renders_saves_and_focuses() {
     let x = explorer(2);
