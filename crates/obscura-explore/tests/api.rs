@@ -66,6 +66,29 @@ async fn call(x: &Arc<Explorer>, method: &str, uri: &str, body: &str) -> (Status
 
 /// An answer that must be an error in the documented form: JSON `{"error": MESSAGE, "key":
 /// KEY-or-null}` with a message; its status and body.
+/// Autofocus at (`px`, `py`) of session `id`'s image: the depth found, and the answer.
+async fn focus_at(x: &Arc<Explorer>, id: u64, px: f64, py: f64) -> (f64, Value) {
+    let uri = format!("/api/focus?session={id}");
+    let (status, v) = call_json(x, "POST", &uri, &json!({"x": px, "y": py}).to_string()).await;
+    assert_eq!(status, StatusCode::OK, "({px}, {py}): {v}");
+    (v["depth"].as_f64().unwrap(), v)
+}
+
+/// Asserts that the request is refused with `status` and a JSON error naming `key`.
+async fn assert_refused(
+    x: &Arc<Explorer>,
+    (method, uri, body): (&str, &str, &str),
+    status: StatusCode,
+    key: &str,
+) {
+    let (got, v) = call_error(x, method, uri, body).await;
+    assert_eq!(
+        (got, &v["key"]),
+        (status, &json!(key)),
+        "{method} {uri} {body}: {v}"
+    );
+}
+
 /// The PNG file `obscura render` writes of `image` (the renderer's own writer).
 fn cli_png(image: &obscura_render::Image) -> Vec<u8> {
     let path =
@@ -379,15 +402,7 @@ async fn a_cropped_views_positions_are_offset_into_the_film() {
     assert_eq!(status, StatusCode::OK, "{c}");
     assert_eq!(c["raster"], json!([25.5, 18.5]), "{c}");
     for ((px, py), depth) in [((0.5, 0.5), 4.002075), ((22.5, 14.5), 7.0)] {
-        let (status, v) = call_json(
-            &x,
-            "POST",
-            &format!("/api/focus?session={id}"),
-            &json!({"x": px, "y": py}).to_string(),
-        )
-        .await;
-        assert_eq!(status, StatusCode::OK, "({px}, {py}): {v}");
-        let got = v["depth"].as_f64().unwrap();
+        let (got, _) = focus_at(&x, id, px, py).await;
         assert!(
             (got - depth).abs() < 1e-4,
             "({px}, {py}): depth {got}, expected {depth}"
@@ -410,15 +425,7 @@ async fn a_session_renders_saves_and_focuses() {
 
     // Autofocus on the sphere's front (depth 4) and on the wall (depth 7).
     for ((px, py), depth) in [((24.0, 16.0), 4.0), ((1.5, 1.5), 7.0)] {
-        let (status, v) = call_json(
-            &x,
-            "POST",
-            &format!("/api/focus?session={id}"),
-            &json!({"x": px, "y": py}).to_string(),
-        )
-        .await;
-        assert_eq!(status, StatusCode::OK, "{v}");
-        let got = v["depth"].as_f64().unwrap();
+        let (got, v) = focus_at(&x, id, px, py).await;
         assert!(
             (got - depth).abs() < 1e-3,
             "({px}, {py}): depth {got}, expected {depth}"
@@ -701,15 +708,10 @@ async fn a_scene_file_beyond_the_limits_is_previewed_at_them_and_says_so() {
     assert_eq!(status, StatusCode::OK, "{v}");
     assert_eq!(v["resolution"], json!([2048, 2048]), "{v}");
     // ...a page asking for more than the limits is still refused...
-    let (status, v) = call_error(
-        &x,
-        "POST",
-        &format!("/api/view?session={id}"),
-        r#"{"resolution": [10000, 10000]}"#,
-    )
-    .await;
-    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{v}");
-    assert_eq!(v["key"], json!("film.resolution"));
+    let uri = format!("/api/view?session={id}");
+    let body = r#"{"resolution": [10000, 10000]}"#;
+    let unprocessable = StatusCode::UNPROCESSABLE_ENTITY;
+    assert_refused(&x, ("POST", &uri, body), unprocessable, "film.resolution").await;
     // ...and the saved scene keeps the file's own film and spp.
     let (_, toml) = call(&x, "GET", &format!("/api/scene.toml?session={id}"), "").await;
     let saved: toml::Table = std::str::from_utf8(&toml).unwrap().parse().unwrap();
@@ -913,20 +915,16 @@ async fn a_stereo_pairs_api_saves_and_points_as_the_command_line_would() {
 
     // Separate: one file per eye, as `obscura render` writes NAME-left and NAME-right; the
     // request names the eye.
-    let (status, v) = call_error(&x, "GET", &format!("/api/image.png?session={id}"), "").await;
-    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{v}");
-    assert_eq!(v["key"], json!("eye"));
-    let (status, v) = call_error(
+    let png = format!("/api/image.png?session={id}");
+    assert_refused(
         &x,
-        "GET",
-        &format!("/api/image.exr?session={id}&eye=middle"),
-        "",
+        ("GET", &png, ""),
+        StatusCode::UNPROCESSABLE_ENTITY,
+        "eye",
     )
     .await;
-    assert_eq!(
-        (status, &v["key"]),
-        (StatusCode::BAD_REQUEST, &json!("eye"))
-    );
+    let exr = format!("/api/image.exr?session={id}&eye=middle");
+    assert_refused(&x, ("GET", &exr, ""), StatusCode::BAD_REQUEST, "eye").await;
     let [left, right] = eyes_rendered(&stereo_view("separate"));
     for (eye, image) in [("left", &left), ("right", &right)] {
         let uri = format!("/api/image.png?session={id}&eye={eye}");
@@ -1066,17 +1064,14 @@ async fn a_stereo_pairs_api_saves_and_points_as_the_command_line_would() {
         s["frame_generation"] == generation && s["passes_done"] == json!(4)
     })
     .await;
-    let (status, v) = call_error(
+    let png = format!("/api/image.png?session={id}&eye=left");
+    assert_refused(
         &x,
-        "GET",
-        &format!("/api/image.png?session={id}&eye=left"),
-        "",
+        ("GET", &png, ""),
+        StatusCode::UNPROCESSABLE_ENTITY,
+        "eye",
     )
     .await;
-    assert_eq!(
-        (status, &v["key"]),
-        (StatusCode::UNPROCESSABLE_ENTITY, &json!("eye"))
-    );
     let (_, c) = call_json(
         &x,
         "GET",
@@ -1107,9 +1102,13 @@ async fn a_stereo_scene_beyond_the_limits_counts_its_eyes_twice() {
             .contains("per eye"),
         "{s}"
     );
-    let (status, v) = call_error(&x, "POST", "/api/view", r#"{"resolution": [1449, 1449]}"#).await;
-    assert_eq!(
-        (status, &v["key"]),
-        (StatusCode::UNPROCESSABLE_ENTITY, &json!("film.resolution"))
-    );
+    let body = r#"{"resolution": [1449, 1449]}"#;
+    let unprocessable = StatusCode::UNPROCESSABLE_ENTITY;
+    assert_refused(
+        &x,
+        ("POST", "/api/view", body),
+        unprocessable,
+        "film.resolution",
+    )
+    .await;
 }
