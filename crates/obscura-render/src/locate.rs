@@ -71,71 +71,113 @@ pub(crate) fn line_of_key(source: &str, path: &str) -> Option<usize> {
     line
 }
 
-/// The key path written on line `line` (the key of a `key = value` line, qualified by its
-/// table, or a table's header), or else the innermost key whose value spans that line: for
-/// serde errors, which carry a span but no key.
-pub(crate) fn key_at_line(source: &str, line: usize) -> Option<String> {
+/// The key path a serde error at byte `at` is about, with the error's `message`:
+/// - the innermost key written at `at`, or whose value holds it (a value of the wrong type,
+///   an unknown key inside an inline table);
+/// - else, for a key the parse could not keep (a duplicate), that key's text under the
+///   table it is written in;
+/// - and for `missing field` errors, the missing key under the table the error is about.
+pub(crate) fn key_at(source: &str, at: usize, message: &str) -> Option<String> {
     let (root, _) = DeTable::parse_recoverable(source);
-    let mut on_line = None;
-    let mut around = None;
-    visit(source, root.get_ref(), "", line, &mut on_line, &mut around);
-    on_line.or(around)
+    let mut found = Found::default();
+    visit(source, root.get_ref(), "", at, &mut found);
+    if let Some(missing) = message
+        .strip_prefix("missing field `")
+        .and_then(|m| m.split('`').next())
+    {
+        let table = found.table.map(|(_, path)| path);
+        return Some(match table {
+            Some(t) => format!("{t}.{missing}"),
+            None => missing.to_string(),
+        });
+    }
+    if found.exact.is_some() {
+        return found.exact;
+    }
+    // A key written at `at` that the parse dropped: its text, under the table in force there.
+    let word: String = source
+        .get(at..)?
+        .chars()
+        .take_while(|c| c.is_ascii_alphanumeric() || *c == '_' || *c == '-')
+        .collect();
+    let table = found.table.map(|(_, path)| path);
+    match (table, word.is_empty()) {
+        (Some(t), false) => Some(format!("{t}.{word}")),
+        (None, false) => Some(word),
+        (t, true) => t,
+    }
 }
 
-/// Walks `table` under `prefix`, keeping the last key written on `line` and the last (so the
-/// innermost) whose value's lines hold it.
-fn visit(
-    source: &str,
-    table: &DeTable<'_>,
-    prefix: &str,
-    line: usize,
-    on_line: &mut Option<String>,
-    around: &mut Option<String>,
-) {
+/// What [`visit`] finds for an offset.
+#[derive(Default)]
+struct Found {
+    /// The innermost key at the offset, or whose value holds it.
+    exact: Option<String>,
+    /// The table (by where its header or element starts) the offset lies under.
+    table: Option<(usize, String)>,
+}
+
+/// Walks `table` under `prefix` for offset `at`.
+fn visit(source: &str, table: &DeTable<'_>, prefix: &str, at: usize, found: &mut Found) {
     for (key, value) in table {
         let path = if prefix.is_empty() {
             key.get_ref().to_string()
         } else {
             format!("{prefix}.{}", key.get_ref())
         };
-        if line_of_offset(source, key.span().start) == line {
-            *on_line = Some(path.clone());
+        if key.span().contains(&at) {
+            found.exact = Some(path.clone());
         }
-        visit_value(source, value, &path, line, on_line, around);
+        visit_value(source, value, &path, key.span().start, at, found);
     }
 }
 
-/// [`visit`] for a value: tables are walked, arrays' elements named by index.
+/// [`visit`] for a value written from `start`: tables are walked, arrays' elements named by
+/// index.
 fn visit_value(
     source: &str,
     value: &Spanned<DeValue<'_>>,
     path: &str,
-    line: usize,
-    on_line: &mut Option<String>,
-    around: &mut Option<String>,
+    start: usize,
+    at: usize,
+    found: &mut Found,
 ) {
     let span = value.span();
-    let (first, last) = (
-        line_of_offset(source, span.start),
-        line_of_offset(source, span.end.saturating_sub(1).max(span.start)),
-    );
-    if (first..=last).contains(&line) {
-        *around = Some(path.to_string());
-    }
+    let inside = span.start <= at && at < span.end.max(span.start + 1);
     match value.get_ref() {
-        DeValue::Table(t) => visit(source, t, path, line, on_line, around),
+        DeValue::Table(t) => {
+            // A table's own span may be its header alone: the table in force at `at` is the
+            // last one started before it, an inline table only up to its closing brace.
+            let inline = source.get(span.start..).is_some_and(|t| t.starts_with('{'));
+            let open = !inline || at < span.end;
+            if start <= at && open && found.table.as_ref().is_none_or(|(s, _)| start >= *s) {
+                found.table = Some((start, path.to_string()));
+            }
+            if inside && t.is_empty() {
+                found.exact = Some(path.to_string());
+            }
+            visit(source, t, path, at, found);
+        }
         DeValue::Array(a) => {
+            if inside {
+                found.exact = Some(path.to_string());
+            }
             for (i, element) in a.iter().enumerate() {
-                let path = format!("{path}[{i}]");
-                if let DeValue::Table(_) = element.get_ref()
-                    && line_of_offset(source, element.span().start) == line
-                {
-                    *on_line = Some(path.clone());
-                }
-                visit_value(source, element, &path, line, on_line, around);
+                visit_value(
+                    source,
+                    element,
+                    &format!("{path}[{i}]"),
+                    element.span().start,
+                    at,
+                    found,
+                );
             }
         }
-        _ => {}
+        _ => {
+            if inside {
+                found.exact = Some(path.to_string());
+            }
+        }
     }
 }
 
@@ -180,25 +222,66 @@ mod tests {
             Some(8)
         );
         assert_eq!(line_of_key(scene, "integrator.stereo.interaxial"), Some(14));
-        assert_eq!(key_at_line(scene, 7).as_deref(), Some("camera.fov"));
+        // Serde's errors point at a key or a value: the innermost key there.
+        let key = |needle: &str| key_at(scene, scene.find(needle).unwrap(), "");
+        assert_eq!(key("fov = 180").as_deref(), Some("camera.fov"));
+        assert_eq!(key("180.0").as_deref(), Some("camera.fov"));
         assert_eq!(
-            key_at_line(scene, 4).as_deref(),
-            Some("camera.shutter_curve[1][1]"),
-            "the innermost value on a row of the array"
+            key("0.5, 1.0]").as_deref(),
+            Some("camera.shutter_curve[1][0]"),
+            "a value in a row of the array"
         );
         assert_eq!(
-            key_at_line(scene, 11).as_deref(),
+            key("\"up\"").as_deref(),
+            Some("camera.rolling_shutter.direction")
+        );
+        assert_eq!(
+            key("readout").as_deref(),
+            Some("camera.rolling_shutter.readout")
+        );
+        assert_eq!(
+            key("fov = 3").as_deref(),
             Some("integrator.note"),
             "inside a string"
         );
-        assert_eq!(key_at_line(scene, 9).as_deref(), Some("integrator"));
+        assert_eq!(
+            key("interaxial").as_deref(),
+            Some("integrator.stereo.interaxial")
+        );
+    }
+
+    /// The keys of errors that name no written key: a duplicate (the parse keeps the first),
+    /// and a missing key, under the table the error is about.
+    #[test]
+    fn duplicates_and_missing_keys_are_named() {
+        let scene = "[film]\nresolution = [4, 4]\n[camera]\nrolling_shutter = { readout = 1 }\n\
+                     fov = 30\nfov = 40\n[[shapes]]\nradius = 1\n";
+        let second = scene.rfind("fov").unwrap();
+        assert_eq!(
+            key_at(scene, second, "duplicate key").as_deref(),
+            Some("camera.fov")
+        );
+        // Serde's missing-field errors point at the start of the table they are about.
+        assert_eq!(
+            key_at(scene, 0, "missing field `integrator`").as_deref(),
+            Some("integrator")
+        );
+        let shape = scene.find("[[shapes]]").unwrap();
+        assert_eq!(
+            key_at(scene, shape, "missing field `type`").as_deref(),
+            Some("shapes[0].type")
+        );
     }
 
     #[test]
-    fn lines_give_their_keys() {
-        assert_eq!(key_at_line(SCENE, 6).as_deref(), Some("camera.fov"));
-        assert_eq!(key_at_line(SCENE, 8).as_deref(), Some("shapes[0]"));
-        assert_eq!(key_at_line(SCENE, 13).as_deref(), Some("shapes[1].origin"));
+    fn offsets_give_their_keys() {
+        let key = |needle: &str| key_at(SCENE, SCENE.find(needle).unwrap(), "");
+        assert_eq!(key("fov").as_deref(), Some("camera.fov"));
+        assert_eq!(key("origin").as_deref(), Some("shapes[1].origin"));
+        assert_eq!(
+            key("[1, 1, 1]").as_deref(),
+            Some("materials.white.reflectance")
+        );
         assert_eq!(line_of_offset(SCENE, 0), 1);
         assert_eq!(line_of_offset(SCENE, SCENE.find("fov").unwrap()), 6);
     }

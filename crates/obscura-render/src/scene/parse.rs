@@ -7,7 +7,7 @@ use super::raw::{
 };
 use super::settings::*;
 use crate::error::RenderError;
-use crate::locate::{key_at_line, line_of_offset};
+use crate::locate::{key_at, line_of_offset};
 use obscura_sample::SamplerKind;
 use obscura_space::{SpaceError, Transform, World};
 use serde::de::DeserializeOwned;
@@ -120,14 +120,40 @@ fn read_scene(path: &Path) -> Result<String, RenderError> {
 /// value of the wrong type is an error at the line serde's span points to.
 fn from_toml<T: DeserializeOwned>(path: &Path, source: &str) -> Result<T, RenderError> {
     toml::from_str(source).map_err(|e| {
-        let line = e.span().map(|s| line_of_offset(source, s.start));
+        let at = e.span().map(|s| s.start);
+        let message = e.message().trim();
         RenderError::Scene {
             file: path.to_path_buf(),
-            line,
-            key: line.and_then(|l| key_at_line(source, l)),
-            message: e.message().trim().to_string(),
+            line: at.map(|at| line_of_offset(source, at)),
+            key: at.and_then(|at| key_at(source, at, message)),
+            message: in_toml_words(message),
         }
     })
+}
+
+/// Serde's message in the scene format's words: Rust's number types and serde's `sequence`
+/// and `map` become what a TOML file has (a number, an array, a table).
+fn in_toml_words(message: &str) -> String {
+    [
+        ("expected f32", "expected a number"),
+        ("expected f64", "expected a number"),
+        ("expected u8", "expected a whole number"),
+        ("expected u32", "expected a whole number"),
+        ("expected u64", "expected a whole number"),
+        ("expected usize", "expected a whole number"),
+        ("expected i32", "expected an integer"),
+        ("expected i64", "expected an integer"),
+        ("expected a sequence", "expected an array"),
+        ("expected a map", "expected a table"),
+    ]
+    .iter()
+    .fold(message.to_string(), |m, (rust, toml)| m.replace(rust, toml))
+}
+
+/// `kind` with its indefinite article: "an integer", "a string".
+fn with_article(kind: &str) -> String {
+    let an = kind.starts_with(['a', 'e', 'i', 'o', 'u']);
+    format!("{} {kind}", if an { "an" } else { "a" })
 }
 
 /// The file and its text, for errors that find their own line.
@@ -227,8 +253,8 @@ impl Cx<'_> {
                 return Err(self.err(
                     "film.filter",
                     format!(
-                        "must be a filter name or a table {{ type, radius }}, got a {}",
-                        other.type_str()
+                        "must be a filter name or a table {{ type, radius }}, got {}",
+                        with_article(other.type_str())
                     ),
                 ));
             }
@@ -761,8 +787,9 @@ mod tests {
         }
     }
 
-    /// A table given as another kind of value says it wants a table, in the scene format's
-    /// words: no Rust struct's name (`expected struct RawFilm`) in the message.
+    /// A table given as another kind of value, an array included, says it wants a table, in
+    /// the scene format's words: no Rust struct's name (`expected struct RawFilm`) in the
+    /// message, and no table filled from an array by position.
     #[test]
     fn a_value_where_a_table_belongs_asks_for_a_table() {
         let body = "[[shapes]]\ntype = \"sphere\"\nradius = 1.0\n";
@@ -787,6 +814,24 @@ mod tests {
             ),
             (format!("{CAMERA}[materials]\nm = 3\n{body}"), "materials.m"),
             (format!("lights = [7]\n{CAMERA}{body}"), "lights"),
+            // Arrays where a table belongs: serde alone would fill the table by position.
+            (
+                format!("{CAMERA}stereo = [0.1, 5.0, \"separate\"]\n{body}"),
+                "camera.stereo",
+            ),
+            (
+                format!("{CAMERA}rolling_shutter = [0.5, \"top_to_bottom\"]\n{body}"),
+                "camera.rolling_shutter",
+            ),
+            (
+                format!("{CAMERA}{body}transform = [[[2, 2, 2]]]\n"),
+                "shapes[0].transform",
+            ),
+            (
+                format!("film = [[8, 8]]\n[camera]\ntype = \"perspective\"\n{body}"),
+                "film",
+            ),
+            (format!("materials = 5\n{CAMERA}{body}"), "materials"),
         ] {
             let e = parse_description(Path::new("s.toml"), &bad).expect_err(&bad);
             let text = e.to_string();
@@ -798,6 +843,62 @@ mod tests {
                 panic!("{bad}: no key in {e:?}");
             };
             assert!(k.starts_with(key), "{bad}: key {k}, want {key}");
+        }
+    }
+
+    /// Serde's other type words become the scene format's: arrays, numbers; and an error on a
+    /// line with several keys names the key at fault, a duplicate key its own name.
+    #[test]
+    fn errors_name_the_key_at_fault_in_toml_words() {
+        let body = "[[shapes]]\ntype = \"sphere\"\nradius = 1.0\n";
+        for (bad, want, words) in [
+            (
+                format!("shapes = 5\n{CAMERA}"),
+                "shapes",
+                "expected an array",
+            ),
+            (
+                format!("{CAMERA}near = \"close\"\n{body}"),
+                "camera.near",
+                "expected a number",
+            ),
+            (
+                format!("{CAMERA}rolling_shutter = {{ readout = 0.5, direction = 3 }}\n{body}"),
+                "camera.rolling_shutter.direction",
+                "expected a string",
+            ),
+            (
+                format!("{CAMERA}rolling_shutter = {{ bogus = 1, readout = 0.5 }}\n{body}"),
+                "camera.rolling_shutter.bogus",
+                "unknown field",
+            ),
+            (
+                format!(
+                    "{CAMERA}{body}transform = [{{ rotate = \"x\" }}, {{ translate = [0, 1, 0] }}]\n"
+                ),
+                "shapes[0].transform[0].rotate",
+                "expected an array",
+            ),
+            (
+                format!("{CAMERA}fov = 30.0\n{body}"),
+                "camera.fov",
+                "duplicate key",
+            ),
+            (
+                "[film]\nresolution = [4, 4]\n".to_string(),
+                "camera",
+                "missing field `camera`",
+            ),
+        ] {
+            let e = parse_description(Path::new("s.toml"), &bad).expect_err(&bad);
+            let RenderError::Scene { key, message, .. } = &e else {
+                panic!("{bad}: not a scene error: {e:?}");
+            };
+            assert_eq!(key.as_deref(), Some(want), "{bad}: {e}");
+            assert!(
+                message.contains(words) && !message.contains("Raw"),
+                "{bad}: {e}"
+            );
         }
     }
 }

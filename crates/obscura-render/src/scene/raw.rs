@@ -8,17 +8,19 @@ use std::collections::BTreeMap;
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields, expecting = "a scene file of tables")]
 pub(super) struct RawScene {
+    #[serde(deserialize_with = "table::one")]
     pub(super) film: RawFilm,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "table::one")]
     pub(super) sampler: RawSampler,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "table::one")]
     pub(super) integrator: RawIntegrator,
+    #[serde(deserialize_with = "table::one")]
     pub(super) camera: RawCamera,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "table::named")]
     pub(super) materials: BTreeMap<String, RawMaterial>,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "table::many")]
     pub(super) shapes: Vec<RawShape>,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "table::many")]
     pub(super) lights: Vec<RawLight>,
 }
 
@@ -28,9 +30,11 @@ pub(super) struct RawScene {
 #[derive(Deserialize)]
 #[serde(expecting = "a scene file of tables")]
 pub(super) struct RawCameraPart {
+    #[serde(deserialize_with = "table::one")]
     pub(super) film: RawFilm,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "table::one")]
     pub(super) sampler: RawSamplerType,
+    #[serde(deserialize_with = "table::one")]
     pub(super) camera: RawCamera,
 }
 
@@ -112,6 +116,7 @@ pub(super) struct RawCamera {
     pub(super) face: Option<String>,
     #[serde(default, deserialize_with = "fixed::optional")]
     pub(super) lens_shift: Option<[f32; 2]>,
+    #[serde(default, deserialize_with = "table::optional")]
     pub(super) stereo: Option<RawStereo>,
     #[serde(default, deserialize_with = "fixed::optional")]
     pub(super) pose: Option<[f32; 16]>,
@@ -125,6 +130,7 @@ pub(super) struct RawCamera {
     pub(super) anamorphic: Option<f32>,
     #[serde(default, deserialize_with = "fixed::optional_list")]
     pub(super) shutter_curve: Option<Vec<[f32; 2]>>,
+    #[serde(default, deserialize_with = "table::optional")]
     pub(super) rolling_shutter: Option<RawRollingShutter>,
     #[serde(default, deserialize_with = "fixed::optional")]
     pub(super) focal_plane_tilt: Option<[f32; 2]>,
@@ -182,7 +188,9 @@ pub(super) struct RawShape {
     pub(super) material: Option<String>,
     #[serde(default, deserialize_with = "fixed::optional")]
     pub(super) emission: Option<V3>,
+    #[serde(default, deserialize_with = "table::optional_many")]
     pub(super) transform: Option<Vec<RawOp>>,
+    #[serde(default, deserialize_with = "table::optional_many")]
     pub(super) transform_end: Option<Vec<RawOp>>,
 }
 
@@ -218,7 +226,79 @@ pub(super) struct RawLight {
     #[serde(default, deserialize_with = "fixed::optional")]
     pub(super) radiance: Option<V3>,
     pub(super) file: Option<String>,
+    #[serde(default, deserialize_with = "table::optional_many")]
     pub(super) transform: Option<Vec<RawOp>>,
+}
+
+/// Tables only. Serde also fills a struct from an array, by position
+/// (`stereo = [0.1, 5.0, "separate"]`), which the scene format does not have: these read a
+/// table's keys and refuse any other value with "expected a table".
+pub(super) mod table {
+    use serde::de::value::MapAccessDeserializer;
+    use serde::de::{Deserialize, Deserializer, MapAccess, Visitor};
+    use std::collections::BTreeMap;
+    use std::fmt;
+    use std::marker::PhantomData;
+
+    /// Accepts a table only, and reads `T` from its keys.
+    struct OnlyTable<T>(PhantomData<T>);
+
+    impl<'de, T: Deserialize<'de>> Visitor<'de> for OnlyTable<T> {
+        type Value = T;
+
+        fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+            f.write_str("a table")
+        }
+
+        fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<T, A::Error> {
+            T::deserialize(MapAccessDeserializer::new(map))
+        }
+    }
+
+    /// `T` read from a table only, as an element of an array or a map.
+    struct Tabled<T>(T);
+
+    impl<'de, T: Deserialize<'de>> Deserialize<'de> for Tabled<T> {
+        fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+            one(d).map(Tabled)
+        }
+    }
+
+    /// A table.
+    pub(in crate::scene) fn one<'de, D: Deserializer<'de>, T: Deserialize<'de>>(
+        d: D,
+    ) -> Result<T, D::Error> {
+        d.deserialize_map(OnlyTable(PhantomData))
+    }
+
+    /// A table, when the key is given.
+    pub(in crate::scene) fn optional<'de, D: Deserializer<'de>, T: Deserialize<'de>>(
+        d: D,
+    ) -> Result<Option<T>, D::Error> {
+        one(d).map(Some)
+    }
+
+    /// An array of tables.
+    pub(in crate::scene) fn many<'de, D: Deserializer<'de>, T: Deserialize<'de>>(
+        d: D,
+    ) -> Result<Vec<T>, D::Error> {
+        Vec::<Tabled<T>>::deserialize(d).map(|v| v.into_iter().map(|t| t.0).collect())
+    }
+
+    /// An array of tables, when the key is given.
+    pub(in crate::scene) fn optional_many<'de, D: Deserializer<'de>, T: Deserialize<'de>>(
+        d: D,
+    ) -> Result<Option<Vec<T>>, D::Error> {
+        many(d).map(Some)
+    }
+
+    /// A table of tables, by name.
+    pub(in crate::scene) fn named<'de, D: Deserializer<'de>, T: Deserialize<'de>>(
+        d: D,
+    ) -> Result<BTreeMap<String, T>, D::Error> {
+        BTreeMap::<String, Tabled<T>>::deserialize(d)
+            .map(|m| m.into_iter().map(|(k, t)| (k, t.0)).collect())
+    }
 }
 
 /// Fixed-length arrays that refuse extra entries as well as missing ones: the `toml` crate's
