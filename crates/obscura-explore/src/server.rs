@@ -2,7 +2,7 @@
 
 use crate::error::ExploreError;
 use crate::request::{Params, pixel};
-use crate::session::{Session, coordinates, png_bytes, preview_depth};
+use crate::session::{Session, coordinates, on_image, png_bytes, preview_depth};
 use crate::stereo::{Pick, eye_name, eye_of_name, layout_name, pair_layout, pick, shown};
 use crate::view::{MAX_EDGE, MAX_PIXELS, MAX_SPP, View, ViewChange};
 use axum::Router;
@@ -179,7 +179,11 @@ async fn asset(UrlPath(file): UrlPath<String>) -> Response {
 /// and `stereo` how a pair is shown (null for a single view).
 fn view_json(view: &View) -> Json {
     let d = view.description();
+    // The image is the crop window's pixels (the whole film without one).
     let [w, h] = d.film.resolution;
+    let [x0, x1, y0, y1] = obscura_camera::FilmGeometry::new(d.film.resolution, None, d.film.crop)
+        .map_or([0, w, 0, h], |f| f.pixel_bounds());
+    let (w, h) = (x1 - x0, y1 - y0);
     let stereo = pair_layout(d).map(|layout| {
         let shown = shown(layout);
         let width = if shown == StereoLayout::Anaglyph {
@@ -303,8 +307,9 @@ async fn coords(State(x): Api, q: Params) -> Result<Response, ExploreError> {
     let centre = camera_of(d)?;
     // The page's image starts at the crop window's first pixel, the film's raster at the
     // full film's.
-    let [x0, x1, y0, _] = Camera::film(&centre).pixel_bounds();
+    let [x0, x1, y0, y1] = Camera::film(&centre).pixel_bounds();
     let (dx, dy) = (x0 as f32, y0 as f32);
+    on_image(pair_layout(d).map(shown), x1 - x0, y1 - y0, px, py)?;
     let Some(layout) = pair_layout(d) else {
         let mut c = coordinates(&centre, px + dx, py + dy);
         c["eye"] = Json::Null;

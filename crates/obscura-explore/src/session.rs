@@ -113,24 +113,12 @@ impl Stage {
         // full film's.
         let b = self.scene.pixel_bounds;
         let (x0, y0) = (b.x0 as f32, b.y0 as f32);
+        let (w, h) = (b.x1 - b.x0, b.y1 - b.y0);
+        let layout = self.pair.as_ref().map(|(_, layout)| *layout);
+        on_image(layout, w, h, x, y)?;
         let Some((eyes, layout)) = &self.pair else {
             return depth_through(&self.scene, &self.centre, x + x0, y + y0);
         };
-        let (w, h) = (b.x1 - b.x0, b.y1 - b.y0);
-        let preview_w = match layout {
-            StereoLayout::Anaglyph => w,
-            _ => 2 * w,
-        };
-        if !(x.is_finite() && y.is_finite())
-            || x < 0.0
-            || y < 0.0
-            || x >= preview_w as f32
-            || y >= h as f32
-        {
-            return Err(ExploreError::NothingThere(format!(
-                "({x}, {y}) is off the stereo pair's preview [0, {preview_w}) x [0, {h})"
-            )));
-        }
         let Pick { eye, x, y } = pick(Some(*layout), w, x, y);
         let camera = match eye {
             None => &self.centre,
@@ -138,6 +126,28 @@ impl Stage {
             Some(StereoEye::Right) => &eyes[1],
         };
         depth_through(&self.scene, camera, x + x0, y + y0)
+    }
+}
+
+/// Refuses a position off the page's image: the crop window's `w` x `h` pixels, twice as wide
+/// for a pair shown side by side (`shown`).
+pub(crate) fn on_image(
+    shown: Option<StereoLayout>,
+    w: u32,
+    h: u32,
+    x: f32,
+    y: f32,
+) -> Result<(), ExploreError> {
+    let width = match shown {
+        Some(StereoLayout::SideBySide | StereoLayout::Separate) => 2 * w,
+        _ => w,
+    };
+    if x.is_finite() && y.is_finite() && x >= 0.0 && y >= 0.0 && x < width as f32 && y < h as f32 {
+        Ok(())
+    } else {
+        Err(ExploreError::NothingThere(format!(
+            "({x}, {y}) is off the image [0, {width}) x [0, {h})"
+        )))
     }
 }
 

@@ -408,6 +408,30 @@ async fn a_cropped_views_positions_are_offset_into_the_film() {
             "({px}, {py}): depth {got}, expected {depth}"
         );
     }
+    // Off the 24 x 16 image: refused in the image's terms, for the overlay too.
+    for (method, uri, body) in [
+        (
+            "POST",
+            format!("/api/focus?session={id}"),
+            r#"{"x": 30, "y": 10}"#,
+        ),
+        ("GET", format!("/api/coords?session={id}&x=10&y=20"), ""),
+    ] {
+        let (status, v) = call_error(&x, method, &uri, body).await;
+        assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{uri}: {v}");
+        let message = v["error"].as_str().unwrap();
+        assert!(
+            message.contains("off the image [0, 24) x [0, 16)"),
+            "{uri}: {message}"
+        );
+    }
+    // A cropped pair's image is the two eyes' windows side by side: 2 x 24 by 16.
+    let text = format!("{text}[camera.stereo]\ninteraxial = 0.1\nconvergence = 5.0\n");
+    let view = View::parse(&PathBuf::from("explore-test.toml"), &text).unwrap();
+    let x = Explorer::new(view, Some(1));
+    let (status, v) = call_json(&x, "GET", "/api/scene", "").await;
+    assert_eq!(status, StatusCode::OK, "{v}");
+    assert_eq!(v["stereo"]["image"], json!([48, 16]), "{v}");
 }
 
 #[tokio::test]
