@@ -566,26 +566,44 @@ impl Cx<'_> {
         Ok(derived)
     }
 
-    /// The aperture image: a PNG (or any format the image crate reads) relative to the scene
-    /// file, decoded to linear luminance weights (sRGB decoded, Rec. 709 luminance, times
-    /// alpha).
+    /// The aperture image relative to the scene file: an OpenEXR file's linear values, or a
+    /// PNG (any format the image crate reads) sRGB-decoded; the weights are Rec. 709 luminance
+    /// times alpha.
     fn aperture_image(&self, file: &str) -> Result<ApertureImage, RenderError> {
         let path = self.file.parent().unwrap_or(Path::new("")).join(file);
-        let decoded = image::open(&path).map_err(|e| {
+        let cannot = |e: &dyn std::fmt::Display| {
             self.err(
                 "camera.aperture_image",
                 format!("cannot read the aperture image {}: {e}", path.display()),
             )
-        })?;
-        let rgba = decoded.to_rgba8();
-        let (width, height) = rgba.dimensions();
-        let weights: Vec<f32> = rgba
-            .pixels()
-            .map(|p| {
-                let [r, g, b] = [p[0], p[1], p[2]].map(srgb_to_linear);
-                (0.2126 * r + 0.7152 * g + 0.0722 * b) * f32::from(p[3]) / 255.0
-            })
-            .collect();
+        };
+        let luminance =
+            |[r, g, b]: [f32; 3], alpha: f32| (0.2126 * r + 0.7152 * g + 0.0722 * b) * alpha;
+        let exr = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+        let (weights, width, height) = if exr {
+            let (image, _) = crate::read_exr(&path).map_err(|e| cannot(&e))?;
+            let weights = image
+                .pixels
+                .iter()
+                .map(|p| luminance([p[0], p[1], p[2]], p[3]))
+                .collect::<Vec<f32>>();
+            (weights, image.width, image.height)
+        } else {
+            let rgba = image::open(&path).map_err(|e| cannot(&e))?.to_rgba8();
+            let (width, height) = rgba.dimensions();
+            let weights = rgba
+                .pixels()
+                .map(|p| {
+                    luminance(
+                        [p[0], p[1], p[2]].map(srgb_to_linear),
+                        f32::from(p[3]) / 255.0,
+                    )
+                })
+                .collect::<Vec<f32>>();
+            (weights, width, height)
+        };
         ApertureImage::new(&weights, width as usize, height as usize).map_err(|e| {
             self.err(
                 "camera.aperture_image",
@@ -857,5 +875,47 @@ mod tests {
                 other => panic!("{camera}: {other:?}"),
             }
         }
+    }
+
+    /// An aperture image may be an OpenEXR file (pbrt's apertures often are): its linear
+    /// values are the weights. A 4 x 2 image with one lit texel becomes a 4 x 2 aperture; an
+    /// all-black one is refused as black, so the weights are the file's.
+    #[test]
+    fn an_aperture_image_may_be_openexr() {
+        let dir = std::env::temp_dir().join(format!("obscura-aperture-exr-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let write = |name: &str, lit: bool| {
+            let mut pixels = vec![[0.0, 0.0, 0.0, 1.0]; 8];
+            if lit {
+                pixels[5] = [2.0, 2.0, 2.0, 1.0];
+            }
+            let image = crate::Image {
+                width: 4,
+                height: 2,
+                pixels,
+            };
+            let info = crate::ImageInfo {
+                partial: false,
+                samples_per_pixel: 1,
+            };
+            crate::write_image(&dir.join(name), &image, &info).unwrap();
+        };
+        write("lit.exr", true);
+        write("black.exr", false);
+        let scene = |file: &str| {
+            format!(
+                "[film]\nresolution = [8, 8]\n[camera]\nlens_radius = 0.1\nfocal_distance = 2.0\n\
+                 aperture_image = \"{file}\"\n"
+            )
+        };
+        let path = dir.join("s.toml");
+        let d = crate::parse_description(&path, &scene("lit.exr")).unwrap();
+        match &d.camera.lens.aperture.shape {
+            obscura_camera::ApertureShape::Image(image) => assert_eq!(image.size(), [4, 2]),
+            other => panic!("not an image aperture: {other:?}"),
+        }
+        let e = crate::parse_description(&path, &scene("black.exr")).unwrap_err();
+        assert!(e.to_string().contains("black"), "{e}");
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }
