@@ -872,7 +872,6 @@ fn run_convert(scene_path: &Path, output: Option<PathBuf>) -> Result<(), RenderE
             format!("{}: the output must be a .toml file", output.display()),
         ));
     }
-    folder_exists("-o", &output)?;
     let imported = obscura_import::import(scene_path)?;
     for w in &imported.warnings {
         eprintln!("warning: {w}");
