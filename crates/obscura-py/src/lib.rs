@@ -483,7 +483,9 @@ impl PyCamera {
     /// The camera of a scene file: its [camera] and [film] tables, checked as the renderer
     /// checks them, and [sampler] type, the sampler pixel_rays draws from. Every other table
     /// and key is ignored, even one the renderer would refuse. `text_or_path` is the TOML
-    /// text, a path string or an os.PathLike. Every camera model of the scene format works.
+    /// text, a path string or an os.PathLike: a str on one line that names a file, or has no
+    /// `=` (so cannot be a scene), is read as a path; any other str is the text (errors then
+    /// name `<string>`). Every camera model of the scene format works.
     /// Raises ValueError naming the file, key and line for a bad camera or film.
     #[staticmethod]
     fn from_toml(text_or_path: &Bound<'_, PyAny>) -> PyResult<PyCamera> {

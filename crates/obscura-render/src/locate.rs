@@ -94,12 +94,25 @@ pub(crate) fn key_at(source: &str, at: usize, message: &str) -> Option<String> {
     if found.exact.is_some() {
         return found.exact;
     }
-    // A key written at `at` that the parse dropped: its text, under the table in force there.
-    let word: String = source
-        .get(at..)?
-        .chars()
-        .take_while(|c| c.is_ascii_alphanumeric() || *c == '_' || *c == '-')
-        .collect();
+    // A key written at `at` that the parse dropped (a duplicate, or one whose value does not
+    // parse): its text, under the table in force there; the key at the start of `at`'s line
+    // when `at` is in its value.
+    let bare = |text: &str| -> String {
+        text.chars()
+            .take_while(|c| c.is_ascii_alphanumeric() || *c == '_' || *c == '-')
+            .collect()
+    };
+    let mut word = bare(source.get(at..)?);
+    if word.is_empty() {
+        let line_start = source.get(..at)?.rfind('\n').map_or(0, |n| n + 1);
+        let before = source.get(line_start..at)?;
+        if let Some((key, _)) = before.split_once('=') {
+            let key = key.trim();
+            if !key.is_empty() && bare(key) == key {
+                word = key.to_string();
+            }
+        }
+    }
     let table = found.table.map(|(_, path)| path);
     match (table, word.is_empty()) {
         (Some(t), false) => Some(format!("{t}.{word}")),

@@ -50,5 +50,7 @@ pub enum SampleError {
     InvalidShutterCurve {
         /// What is wrong with it, naming the offending point.
         reason: String,
+        /// The offending point's index, when one point is at fault.
+        point: Option<usize>,
     },
 }

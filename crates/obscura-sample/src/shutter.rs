@@ -135,30 +135,41 @@ impl PiecewiseShutterCurve {
     /// points, every number is finite, `t` is strictly increasing within `[0, 1]`, openness
     /// is `>= 0`, and the area under the curve is positive.
     pub fn new(points: &[[f32; 2]]) -> Result<PiecewiseShutterCurve, SampleError> {
-        let bad = |reason: String| Err(SampleError::InvalidShutterCurve { reason });
+        let bad = |point: Option<usize>, reason: String| {
+            Err(SampleError::InvalidShutterCurve { reason, point })
+        };
         if points.len() < 2 {
-            return bad(format!(
-                "needs at least two [t, openness] points, got {}",
-                points.len()
-            ));
+            return bad(
+                None,
+                format!(
+                    "needs at least two [t, openness] points, got {}",
+                    points.len()
+                ),
+            );
         }
         for (i, &[t, o]) in points.iter().enumerate() {
             if !(t.is_finite() && o.is_finite()) {
-                return bad(format!("point {i} [{t}, {o}] is not finite"));
+                return bad(Some(i), format!("point {i} [{t}, {o}] is not finite"));
             }
             if !(0.0..=1.0).contains(&t) {
-                return bad(format!(
-                    "point {i} has t = {t}; times are fractions of the shutter interval in [0, 1]"
-                ));
+                return bad(
+                    Some(i),
+                    format!(
+                        "point {i} has t = {t}; times are fractions of the shutter interval in [0, 1]"
+                    ),
+                );
             }
             if o < 0.0 {
-                return bad(format!("point {i} has negative openness {o}"));
+                return bad(Some(i), format!("point {i} has negative openness {o}"));
             }
             if i > 0 && t <= points[i - 1][0] {
-                return bad(format!(
-                    "t must increase from point to point, but point {i} has t = {t} after {}",
-                    points[i - 1][0]
-                ));
+                return bad(
+                    Some(i),
+                    format!(
+                        "t must increase from point to point, but point {i} has t = {t} after {}",
+                        points[i - 1][0]
+                    ),
+                );
             }
         }
         let points: Vec<[f64; 2]> = points
@@ -173,7 +184,10 @@ impl PiecewiseShutterCurve {
             cumulative.push(area);
         }
         if area <= 0.0 {
-            return bad("the shutter is never open (the area under the curve is 0)".to_string());
+            return bad(
+                None,
+                "the shutter is never open (the area under the curve is 0)".to_string(),
+            );
         }
         Ok(PiecewiseShutterCurve { points, cumulative })
     }

@@ -25,8 +25,10 @@ class Camera:
         """The camera of a scene file's [camera] and [film] tables, from its TOML text or path.
 
         [sampler] type is read too (pixel_rays draws from that sampler); every other table is
-        ignored, even one the renderer would refuse. Raises ValueError naming the file, key and
-        line for a bad camera or film."""
+        ignored, even one the renderer would refuse. A str on one line that names a file, or has
+        no "=" (so cannot be a scene), is read as a path; any other str is the text (errors then
+        name <string>). Raises ValueError naming the file, key and line for a bad camera or
+        film."""
     @staticmethod
     def from_opencv(
         K: _ArrayLike, dist: _ArrayLike, rvec: _ArrayLike, tvec: _ArrayLike, size: Tuple[int, int]

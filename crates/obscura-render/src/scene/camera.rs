@@ -615,10 +615,20 @@ impl Cx<'_> {
     /// `shutter_curve` and `rolling_shutter`.
     fn timing(&self, c: &RawCamera, shutter: Shutter) -> Result<ShutterTiming, RenderError> {
         let curve = match &c.shutter_curve {
-            Some(points) => Some(Arc::new(
-                PiecewiseShutterCurve::new(points)
-                    .map_err(|e| self.camera_err(CameraError::ShutterCurve(e.to_string())))?,
-            )),
+            Some(points) => Some(Arc::new(PiecewiseShutterCurve::new(points).map_err(
+                |e| {
+                    // A point at fault is named by its index, so the message finds its row.
+                    let point = match &e {
+                        obscura_sample::SampleError::InvalidShutterCurve { point, .. } => *point,
+                        _ => None,
+                    };
+                    let message = CameraError::ShutterCurve(e.to_string()).to_string();
+                    match point {
+                        Some(i) => self.err(&format!("camera.shutter_curve[{i}]"), message),
+                        None => self.camera_err(CameraError::ShutterCurve(e.to_string())),
+                    }
+                },
+            )?)),
             None => None,
         };
         let rolling = match &c.rolling_shutter {
@@ -772,7 +782,7 @@ mod tests {
             ("anamorphic = 0.5", "camera.anamorphic"),
             (
                 "shutter_curve = [[0.5, 1.0], [0.2, 1.0]]",
-                "camera.shutter_curve",
+                "camera.shutter_curve[1]",
             ),
             (
                 "rolling_shutter = { readout = 2.0 }",
@@ -797,7 +807,11 @@ mod tests {
                 crate::parse_description(std::path::Path::new("s.toml"), &text).expect_err(camera);
             let line = text
                 .lines()
-                .position(|l| l.starts_with(key.trim_start_matches("camera.")))
+                .position(|l| {
+                    // The key's own line (a point of an array: the array's, on one line).
+                    let name = key.trim_start_matches("camera.");
+                    l.starts_with(name.split('[').next().unwrap_or(name))
+                })
                 .map(|i| i + 1);
             match e {
                 RenderError::Scene {

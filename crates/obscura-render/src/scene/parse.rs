@@ -122,10 +122,16 @@ fn from_toml<T: DeserializeOwned>(path: &Path, source: &str) -> Result<T, Render
     toml::from_str(source).map_err(|e| {
         let at = e.span().map(|s| s.start);
         let message = e.message().trim();
+        let key = at.and_then(|at| key_at(source, at, message));
+        // A table missing from the file has no line (serde points at the file's start).
+        let missing_table = message.starts_with("missing field")
+            && key.as_deref().is_some_and(|k| !k.contains(['.', '[']));
         RenderError::Scene {
             file: path.to_path_buf(),
-            line: at.map(|at| line_of_offset(source, at)),
-            key: at.and_then(|at| key_at(source, at, message)),
+            line: at
+                .filter(|_| !missing_table)
+                .map(|at| line_of_offset(source, at)),
+            key,
             message: in_toml_words(message),
         }
     })
@@ -900,5 +906,19 @@ mod tests {
                 "{bad}: {e}"
             );
         }
+        // A bad point of a multi-line shutter curve: its own row.
+        let text = format!(
+            "{CAMERA}shutter_curve = [\n  [0.0, 0.0],\n  [0.5, -1.0],\n  [1.0, 0.0],\n]\n{body}"
+        );
+        let e = parse_description(Path::new("s.toml"), &text).unwrap_err();
+        let RenderError::Scene { key, line, .. } = &e else {
+            panic!("not a scene error: {e:?}");
+        };
+        assert_eq!(key.as_deref(), Some("camera.shutter_curve[1]"), "{e}");
+        assert_eq!(*line, Some(line_of(&text, "  [0.5, -1.0],")), "{e}");
+        // A table missing from the file has no line to point at.
+        let e =
+            parse_description(Path::new("s.toml"), "[film]\nresolution = [4, 4]\n").unwrap_err();
+        assert!(matches!(e, RenderError::Scene { line: None, .. }), "{e:?}");
     }
 }
