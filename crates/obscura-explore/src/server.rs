@@ -3,7 +3,9 @@
 use crate::error::ExploreError;
 use crate::request::{Params, pixel};
 use crate::session::{Session, coordinates, on_image, png_bytes, preview_depth};
-use crate::stereo::{Pick, eye_name, eye_of_name, layout_name, pair_layout, pick, shown};
+use crate::stereo::{
+    Pick, eye_name, eye_of_name, image_width, layout_name, pair_layout, pick, shown,
+};
 use crate::view::{MAX_EDGE, MAX_PIXELS, MAX_SPP, View, ViewChange};
 use axum::Router;
 use axum::body::Bytes;
@@ -186,11 +188,7 @@ fn view_json(view: &View) -> Json {
     let (w, h) = (x1 - x0, y1 - y0);
     let stereo = pair_layout(d).map(|layout| {
         let shown = shown(layout);
-        let width = if shown == StereoLayout::Anaglyph {
-            w
-        } else {
-            2 * w
-        };
+        let width = image_width(Some(shown), w);
         json!({
             "layout": layout_name(layout),
             "shown": layout_name(shown),

@@ -13,7 +13,7 @@
 //! are exact, so a pair rendered pass by pass is the command line's pair, bit for bit.
 
 use crate::error::ExploreError;
-use crate::stereo::{Pick, cameras_of, pair_layout, pick, shown};
+use crate::stereo::{Pick, cameras_of, image_width, pair_layout, pick, shown};
 use crate::view::{View, ViewChange};
 use obscura_camera::{AnyCamera, Camera, CameraSample, StereoEye};
 use obscura_render::{
@@ -138,10 +138,7 @@ pub(crate) fn on_image(
     x: f32,
     y: f32,
 ) -> Result<(), ExploreError> {
-    let width = match shown {
-        Some(StereoLayout::SideBySide | StereoLayout::Separate) => 2 * w,
-        _ => w,
-    };
+    let width = image_width(shown, w);
     if x.is_finite() && y.is_finite() && x >= 0.0 && y >= 0.0 && x < width as f32 && y < h as f32 {
         Ok(())
     } else {

@@ -20,6 +20,15 @@ pub(crate) fn shown(layout: StereoLayout) -> StereoLayout {
     }
 }
 
+/// The width of the page's image for eyes `eye_width` pixels wide, shown as `shown` (None: a
+/// single view): twice as wide for a pair side by side.
+pub(crate) fn image_width(shown: Option<StereoLayout>, eye_width: u32) -> u32 {
+    match shown {
+        Some(StereoLayout::SideBySide | StereoLayout::Separate) => 2 * eye_width,
+        Some(StereoLayout::Anaglyph) | None => eye_width,
+    }
+}
+
 /// The layout a scene file gives a perspective stereo pair; None when the view renders one
 /// image (no `[camera.stereo]`, or the ODS camera, whose pair is its own projection).
 pub(crate) fn pair_layout(d: &SceneDescription) -> Option<StereoLayout> {

@@ -3,10 +3,6 @@
 use crate::film::Image;
 use crate::scene::StereoLayout;
 
-/// Linear Rec. 709 luminance weights: the anaglyph's red channel is the left eye's luminance,
-/// so that red-filtered viewing sees the left image in full, not only its red.
-const LUMINANCE: [f32; 3] = [0.2126, 0.7152, 0.0722];
-
 /// The left and right eyes' images (same size) as one image: `SideBySide` is twice as wide,
 /// left eye on the left; `Anaglyph` is a half-colour red-cyan anaglyph (red = the left eye's
 /// luminance, green and blue = the right eye's), alpha the mean of the two coverages.
@@ -34,7 +30,9 @@ pub fn compose_stereo(left: &Image, right: &Image, layout: StereoLayout) -> Opti
                 .iter()
                 .zip(&right.pixels)
                 .map(|(l, r)| {
-                    let luminance = LUMINANCE[0] * l[0] + LUMINANCE[1] * l[1] + LUMINANCE[2] * l[2];
+                    // Red is the left eye's luminance, so that red-filtered viewing sees the
+                    // left image in full, not only its red.
+                    let luminance = obscura_shade::luminance(glam::Vec3::new(l[0], l[1], l[2]));
                     [luminance, r[1], r[2], 0.5 * (l[3] + r[3])]
                 })
                 .collect();

@@ -577,8 +577,7 @@ impl Cx<'_> {
                 format!("cannot read the aperture image {}: {e}", path.display()),
             )
         };
-        let luminance =
-            |[r, g, b]: [f32; 3], alpha: f32| (0.2126 * r + 0.7152 * g + 0.0722 * b) * alpha;
+        let luminance = |rgb: [f32; 3], alpha: f32| obscura_shade::luminance(rgb.into()) * alpha;
         let exr = path
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
@@ -618,15 +617,13 @@ impl Cx<'_> {
             Some(points) => Some(Arc::new(PiecewiseShutterCurve::new(points).map_err(
                 |e| {
                     // A point at fault is named by its index, so the message finds its row.
-                    let point = match &e {
-                        obscura_sample::SampleError::InvalidShutterCurve { point, .. } => *point,
-                        _ => None,
+                    let key = match &e {
+                        obscura_sample::SampleError::InvalidShutterCurve {
+                            point: Some(i), ..
+                        } => format!("camera.shutter_curve[{i}]"),
+                        _ => "camera.shutter_curve".to_string(),
                     };
-                    let message = CameraError::ShutterCurve(e.to_string()).to_string();
-                    match point {
-                        Some(i) => self.err(&format!("camera.shutter_curve[{i}]"), message),
-                        None => self.camera_err(CameraError::ShutterCurve(e.to_string())),
-                    }
+                    self.err(&key, CameraError::ShutterCurve(e.to_string()).to_string())
                 },
             )?)),
             None => None,
