@@ -15,8 +15,8 @@ use obvhs::triangle::Triangle;
 
 impl WideBvh {
     /// Builds the tree over `tris`, with two caller ids per triangle reported by its hits,
-    /// using obvhs's binary builder and the given preset.
-    pub(crate) fn build(tris: &[[Vec3A; 3]], ids: &[[u32; 2]], params: BvhBuildParams) -> WideBvh {
+    /// collapsing the binary tree `binary` names.
+    pub(crate) fn build(tris: &[[Vec3A; 3]], ids: &[[u32; 2]], binary: Binary) -> WideBvh {
         debug_assert_eq!(tris.len(), ids.len());
         if tris.is_empty() {
             return WideBvh {
@@ -25,7 +25,7 @@ impl WideBvh {
                 root: EMPTY,
             };
         }
-        let bvh2 = build_bvh2(tris, params);
+        let bvh2 = build_bvh2(tris, binary);
         let mut arrays = Arrays::default();
         let root = Collapse::new(&bvh2, tris, ids).run(&mut arrays);
         drop(bvh2);
@@ -40,39 +40,50 @@ impl WideBvh {
     }
 }
 
-/// obvhs's binary BVH over `tris`, as its CWBVH builder makes it before collapsing.
-fn build_bvh2(tris: &[[Vec3A; 3]], params: BvhBuildParams) -> Bvh2 {
+/// How the binary tree that the collapse reads is built.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Binary {
+    /// obvhs's PLOC and reinsertion with the preset's settings (one triangle per leaf; large
+    /// triangles split into several boxes first when the preset says so).
+    Ploc(BvhBuildParams),
+    /// The binned surface-area builder of `sah.rs` with `bins` bins per axis, over boxes of
+    /// large triangles split as obvhs's preset splits them when `pre_split`.
+    Sah { bins: usize, pre_split: bool },
+}
+
+/// The binary BVH over `tris` that `binary` names.
+fn build_bvh2(tris: &[[Vec3A; 3]], binary: Binary) -> Bvh2 {
     let input = tris
         .iter()
         .map(|&[v0, v1, v2]| Triangle { v0, v1, v2 })
         .collect::<Vec<_>>();
     let indices = (0..tris.len() as u32).collect::<Vec<_>>();
-    let mut bvh2 = if params.pre_split {
-        let mut aabbs = input.iter().map(Triangle::aabb).collect::<Vec<Aabb>>();
+    let pre_split = match binary {
+        Binary::Ploc(params) => params.pre_split,
+        Binary::Sah { pre_split, .. } => pre_split,
+    };
+    let mut aabbs = input.iter().map(Triangle::aabb).collect::<Vec<Aabb>>();
+    let mut indices = indices;
+    if pre_split {
         let largest = aabbs.iter().map(Aabb::half_area).fold(0.0, f32::max);
         let average = aabbs.iter().map(Aabb::half_area).sum::<f32>() / aabbs.len() as f32;
-        let mut indices = indices;
         split_aabbs_preset(&mut aabbs, &mut indices, &input, average, largest);
-        let mut bvh2 = PlocBuilder::with_capacity(aabbs.len()).build(
-            params.ploc_search_distance,
-            &aabbs,
-            indices,
-            params.sort_precision,
-            params.search_depth_threshold,
-        );
-        bvh2.uses_spatial_splits = true;
-        bvh2
-    } else {
-        PlocBuilder::with_capacity(input.len()).build(
-            params.ploc_search_distance,
-            &input,
-            indices,
-            params.sort_precision,
-            params.search_depth_threshold,
-        )
-    };
-    ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
-    bvh2
+    }
+    match binary {
+        Binary::Sah { bins, .. } => super::sah::build(&aabbs, &indices, bins),
+        Binary::Ploc(params) => {
+            let mut bvh2 = PlocBuilder::with_capacity(aabbs.len()).build(
+                params.ploc_search_distance,
+                &aabbs,
+                indices,
+                params.sort_precision,
+                params.search_depth_threshold,
+            );
+            bvh2.uses_spatial_splits = pre_split;
+            ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
+            bvh2
+        }
+    }
 }
 
 /// The nodes and packets of a [`WideBvh`] as the collapse makes them.
@@ -156,7 +167,7 @@ impl<'a> Collapse<'a> {
                 // fits a packet.
                 assert!(
                     node.prim_count as usize <= WIDTH,
-                    "obvhs's PLOC leaves hold one primitive"
+                    "binary leaves hold at most a packet"
                 );
                 cost[i] = [as_packet; ARITY];
                 continue;

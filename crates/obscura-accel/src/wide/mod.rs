@@ -1,7 +1,8 @@
-//! The triangle BVH: obvhs builds the tree, this module lays it out for SIMD and traverses it.
+//! The triangle BVH: built, laid out for SIMD and traversed.
 //!
-//! obvhs builds a binary BVH (PLOC, then reinsertion, with the [`BvhBuildParams`] preset); it is
-//! collapsed here into nodes of up to eight children whose boxes sit in structure-of-arrays
+//! A binary BVH is built top down by binned surface area, each side of a split charged by the
+//! four-triangle packets it fills so that subtrees come in multiples of four (`sah.rs`), or by
+//! obvhs's PLOC and reinsertion for the fast preset ([`Binary`]); it is collapsed here into nodes of up to eight children whose boxes sit in structure-of-arrays
 //! form, one lane per child, so one ray tests eight boxes in two registers' worth of SSE
 //! instructions (written on glam's `Vec4`, four lanes to a register, with the ray's values
 //! kept splatted so a batch reloads them without shuffles). Leaves are one or two *packets* of
@@ -24,9 +25,10 @@
 //! each taking one step and asking for the lines of its next node before the next ray's step,
 //! so that the rays' cache misses overlap instead of following one another.
 //!
-//! The files: `layout.rs` (nodes and packets), `collapse.rs` (the build), `ray.rs` (the slab
-//! and triangle tests), `traverse.rs` (the queries, one step at a time), `batch.rs` (batches
-//! in turns), `boxset.rs` (a top level of few boxes), `stack.rs` (the traversal stack).
+//! The files: `layout.rs` (nodes and packets), `sah.rs` (the binary build), `collapse.rs` (the
+//! collapse), `ray.rs` (the slab and triangle tests), `traverse.rs` (the queries, one step at a
+//! time), `batch.rs` (batches in turns), `boxset.rs` (a top level of few boxes), `stack.rs`
+//! (the traversal stack).
 //!
 //! Everything here is safe Rust: the lanes are glam's `Vec4` (an SSE register on x86-64); the
 //! one prefetch instruction is in the crate's `simd` module.
@@ -36,11 +38,13 @@ mod boxset;
 mod collapse;
 mod layout;
 mod ray;
+mod sah;
 mod stack;
 mod traverse;
 
 pub(crate) use batch::BatchRay;
 pub(crate) use boxset::BoxSet;
+pub(crate) use collapse::Binary;
 
 use crate::geom::TriangleHit;
 use crate::pages::Pages;

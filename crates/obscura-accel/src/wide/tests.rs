@@ -1,8 +1,9 @@
 //! The wide BVH against testing every triangle, and the slab test's rounding bounds.
 
-use super::WideBvh;
 use super::layout::{ARITY, EMPTY, INDEX, LEAF, Node, PAIR, WIDTH};
 use super::ray::{FAR_SCALE, slabs};
+use super::{Binary, WideBvh};
+use crate::BuildQuality;
 use crate::geom::intersect_triangle;
 use glam::{Vec3, Vec3A};
 use obvhs::BvhBuildParams;
@@ -47,10 +48,18 @@ fn soup(n: usize, seed: u32) -> Vec<[Vec3A; 3]> {
 #[test]
 fn the_collapse_keeps_every_triangle_once_inside_its_boxes() {
     let soups = [1, 2, 4, 5, 8, 9, 17, 300].map(|n| soup(n, n as u32));
-    for tris in soups.into_iter().chain([surface(24)]) {
+    let binaries = [
+        BuildQuality::Medium.binary(),
+        Binary::Ploc(BvhBuildParams::medium_build()),
+    ];
+    for (tris, binary) in soups
+        .into_iter()
+        .chain([surface(24)])
+        .flat_map(|tris| binaries.map(|b| (tris.clone(), b)))
+    {
         let n = tris.len();
         let ids = (0..n as u32).map(|i| [i, i + 1000]).collect::<Vec<_>>();
-        let bvh = WideBvh::build(&tris, &ids, BvhBuildParams::medium_build());
+        let bvh = WideBvh::build(&tris, &ids, binary);
         let mut seen = vec![0u32; n];
         let mut pending = vec![(bvh.root, None::<[f32; 6]>, 0usize)];
         let mut depth_max = 0;
@@ -123,19 +132,22 @@ fn queries_match_testing_every_triangle() {
         tris.push([-a, a, a + Vec3A::splat(0.05 * (k + 1) as f32)]);
     }
     let ids = (0..tris.len() as u32).map(|i| [i, 7]).collect::<Vec<_>>();
-    for params in [
-        BvhBuildParams::fast_build(),
-        BvhBuildParams::medium_build(),
-        BvhBuildParams::slow_build(),
+    for (binary, pre_split) in [
+        (Binary::Ploc(BvhBuildParams::fast_build()), false),
+        (Binary::Ploc(BvhBuildParams::medium_build()), false),
+        (Binary::Ploc(BvhBuildParams::slow_build()), true),
+        (BuildQuality::Fast.binary(), false),
+        (BuildQuality::Medium.binary(), false),
+        (BuildQuality::Slow.binary(), true),
     ] {
-        let bvh = WideBvh::build(&tris, &ids, params);
+        let bvh = WideBvh::build(&tris, &ids, binary);
         let lanes: usize = bvh
             .packets
             .iter()
             .map(|p| p.ids[0].iter().filter(|&&i| i != EMPTY).count())
             .sum();
         // Every triangle once, or more than once where the preset splits.
-        assert_eq!(lanes > tris.len(), params.pre_split, "{lanes} lanes");
+        assert_eq!(lanes > tris.len(), pre_split, "{binary:?}: {lanes} lanes");
         check_against_every_triangle(&tris, &bvh);
     }
 }
@@ -147,7 +159,7 @@ fn a_tree_with_two_packet_leaves_answers_the_same() {
     let ids = (0..tris.len() as u32).map(|i| [i, 7]).collect::<Vec<_>>();
     check_against_every_triangle(
         &tris,
-        &WideBvh::build(&tris, &ids, BvhBuildParams::medium_build()),
+        &WideBvh::build(&tris, &ids, BuildQuality::Medium.binary()),
     );
 }
 
@@ -155,12 +167,13 @@ fn a_tree_with_two_packet_leaves_answers_the_same() {
 /// every triangle does, and so does its clone.
 #[test]
 fn a_tree_on_huge_pages_answers_the_same() {
-    let tris: Vec<[Vec3A; 3]> = soup(40_000, 11)
+    // 50,000 triangles fill about 12,600 packets of 192 bytes: over the 2 MiB threshold.
+    let tris: Vec<[Vec3A; 3]> = soup(50_000, 11)
         .into_iter()
         .map(|[a, b, c]| [a, a + (b - a) * 0.1, a + (c - a) * 0.1])
         .collect();
     let ids = (0..tris.len() as u32).map(|i| [i, 7]).collect::<Vec<_>>();
-    let bvh = WideBvh::build(&tris, &ids, BvhBuildParams::fast_build());
+    let bvh = WideBvh::build(&tris, &ids, BuildQuality::Medium.binary());
     if cfg!(target_os = "linux") {
         assert!(
             bvh.packets.is_mapped(),
@@ -240,7 +253,7 @@ fn check_ray(tris: &[[Vec3A; 3]], bvh: &WideBvh, o: Vec3A, dir: Vec3A, t_min: f3
 
 #[test]
 fn an_empty_tree_hits_nothing() {
-    let bvh = WideBvh::build(&[], &[], BvhBuildParams::fast_build());
+    let bvh = WideBvh::build(&[], &[], BuildQuality::Medium.binary());
     let (o, d) = (Vec3A::ZERO, Vec3A::X);
     assert!(bvh.closest(o, d, 0.0, f32::INFINITY).is_none());
     assert!(!bvh.any(o, d, 0.0, f32::INFINITY));
@@ -362,7 +375,7 @@ fn interleaved_batches_answer_as_one_ray_queries() {
     for n in [0, 1, 5, 300, 40_000] {
         let tris = soup(n, 5);
         let ids = (0..n as u32).map(|i| [i, 3]).collect::<Vec<_>>();
-        let bvh = WideBvh::build(&tris, &ids, BvhBuildParams::fast_build());
+        let bvh = WideBvh::build(&tris, &ids, BuildQuality::Medium.binary());
         let dirs = soup(3 * LANES + 5, 17);
         let rays: Vec<BatchRay> = dirs
             .iter()
