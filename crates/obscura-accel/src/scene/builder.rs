@@ -29,7 +29,7 @@ pub enum BuildQuality {
     Medium,
     /// The same build with twice the bins, over large triangles first split into several
     /// boxes (obvhs's pre-splits, meant for long thin triangles whose boxes are mostly
-    /// empty), at a build about a third longer.
+    /// empty), at a build a fifth to a third longer.
     Slow,
 }
 
