@@ -57,13 +57,12 @@ fn build_bvh2(tris: &[[Vec3A; 3]], binary: Binary) -> Bvh2 {
         .iter()
         .map(|&[v0, v1, v2]| Triangle { v0, v1, v2 })
         .collect::<Vec<_>>();
-    let indices = (0..tris.len() as u32).collect::<Vec<_>>();
+    let mut indices = (0..tris.len() as u32).collect::<Vec<_>>();
     let pre_split = match binary {
         Binary::Ploc(params) => params.pre_split,
         Binary::Sah { pre_split, .. } => pre_split,
     };
     let mut aabbs = input.iter().map(Triangle::aabb).collect::<Vec<Aabb>>();
-    let mut indices = indices;
     if pre_split {
         let largest = aabbs.iter().map(Aabb::half_area).fold(0.0, f32::max);
         let average = aabbs.iter().map(Aabb::half_area).sum::<f32>() / aabbs.len() as f32;
@@ -163,8 +162,8 @@ impl<'a> Collapse<'a> {
                 f32::INFINITY
             };
             if node.prim_count != 0 {
-                // A binary leaf is never opened: PLOC makes one per triangle, so it always
-                // fits a packet.
+                // A binary leaf is never opened: PLOC makes one per triangle and the
+                // surface-area build at most four, so it always fits a packet.
                 assert!(
                     node.prim_count as usize <= WIDTH,
                     "binary leaves hold at most a packet"
