@@ -14,7 +14,7 @@ use obvhs::bvh2::Bvh2;
 use obvhs::bvh2::node::Bvh2Node;
 
 /// The most centroid bins a split may use per axis.
-pub(super) const MAX_BINS: usize = 64;
+const MAX_BINS: usize = 64;
 /// Triangles per packet: the unit each side of a split is charged in.
 const BLOCK: u32 = 4;
 /// A range of at most this many boxes becomes a leaf of the binary tree (the collapse may
@@ -43,12 +43,17 @@ impl Bin {
         self.count += other.count;
     }
 
+    /// Counts the box `bounds`, whose centroid is `center`, in this bin.
+    fn insert(&mut self, bounds: &Aabb, center: Vec3A) {
+        self.bounds = self.bounds.union(bounds);
+        self.centroids.extend(center);
+        self.count += 1;
+    }
+
     /// The bin of the boxes in `range`.
     fn of(range: &[u32], aabbs: &[Aabb], centers: &[Vec3A]) -> Bin {
         range.iter().fold(Bin::EMPTY, |mut bin, &i| {
-            bin.bounds = bin.bounds.union(&aabbs[i as usize]);
-            bin.centroids.extend(centers[i as usize]);
-            bin.count += 1;
+            bin.insert(&aabbs[i as usize], centers[i as usize]);
             bin
         })
     }
@@ -151,10 +156,7 @@ fn split(
         let c = centers[i as usize];
         let b = bin_of(c);
         for (axis, axis_bins) in binned.iter_mut().enumerate() {
-            let bin = &mut axis_bins[b[axis] as usize];
-            bin.bounds = bin.bounds.union(&aabbs[i as usize]);
-            bin.centroids.extend(c);
-            bin.count += 1;
+            axis_bins[b[axis] as usize].insert(&aabbs[i as usize], c);
         }
     }
     // The cheapest plane: below it bins [0, plane), above it [plane, bins).

@@ -901,11 +901,12 @@ fn pbrts_aperture_shapes_map_onto_the_stop() {
         height: 64,
         pixels,
     };
-    let info = obscura_render::ImageInfo {
-        partial: false,
-        samples_per_pixel: 1,
-    };
-    obscura_render::write_image(&dir.join("square.png"), &image, &info).unwrap();
+    obscura_render::write_image(
+        &dir.join("square.png"),
+        &image,
+        &obscura_render::ImageInfo::default(),
+    )
+    .unwrap();
     let load = |aperture: &str| {
         let scene = format!(
             "Camera \"realistic\" \"string lensfile\" \"lenses/dgauss.dat\" \

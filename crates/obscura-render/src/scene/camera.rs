@@ -905,11 +905,7 @@ mod tests {
                 height: 2,
                 pixels,
             };
-            let info = crate::ImageInfo {
-                partial: false,
-                samples_per_pixel: 1,
-            };
-            crate::write_image(&dir.join(name), &image, &info).unwrap();
+            crate::write_image(&dir.join(name), &image, &crate::ImageInfo::default()).unwrap();
         };
         write("lit.exr", true);
         write("black.exr", false);
