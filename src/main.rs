@@ -151,7 +151,7 @@ struct RenderArgs {
     /// Sampler seed (overrides the scene's)
     #[arg(long)]
     seed: Option<u64>,
-    /// Worker threads [default: one per core]
+    /// Worker threads, for the BVH build and the render [default: one per core]
     #[arg(long)]
     threads: Option<usize>,
     /// Integrator: path, depth, distance, position, normal or albedo
@@ -265,6 +265,13 @@ fn run_render(args: RenderArgs) -> Result<ExitCode, RenderError> {
         let cap = MAX_THREADS_PER_CORE * cores;
         eprintln!("note: --threads {n} capped at {cap} ({MAX_THREADS_PER_CORE} per core)");
         threads = Some(cap);
+    }
+    // The scene's BVH build runs its large subtrees on rayon's global pool: give it the
+    // render's thread count (the pool is made once; a second call changes nothing).
+    if let Some(n) = threads {
+        let _ = rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global();
     }
     if !(args.checkpoint_every.is_finite() && args.checkpoint_every >= 0.0) {
         return Err(setting(

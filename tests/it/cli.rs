@@ -207,6 +207,74 @@ fn output_is_bit_identical_for_any_thread_count() {
     );
 }
 
+/// A mesh large enough that its BVH is built as parallel tasks (over 16,384 triangles): a flat
+/// 100 x 100 grid of 20,000 triangles over [-1, 1]^2 at z = 0, seen from 2 units away with a
+/// 90-degree field of view, so it covers the middle half of the image. Its depth image is the
+/// same, byte for byte, on one thread and on three, and every pixel over the grid finds it.
+#[test]
+fn a_large_mesh_gives_the_same_image_on_any_number_of_threads() {
+    let dir = scratch("mesh-threads");
+    let n = 100;
+    let mut obj = String::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            let (x, y) = (
+                -1.0 + 2.0 * i as f32 / n as f32,
+                -1.0 + 2.0 * j as f32 / n as f32,
+            );
+            obj += &format!("v {x} {y} 0\n");
+        }
+    }
+    for j in 0..n {
+        for i in 0..n {
+            let a = j * (n + 1) + i + 1;
+            let (b, c, d) = (a + 1, a + n + 1, a + n + 2);
+            obj += &format!("f {a} {b} {d}\nf {a} {d} {c}\n");
+        }
+    }
+    write(&dir, "grid.obj", &obj);
+    let scene = write(
+        &dir,
+        "grid.toml",
+        "[film]\nresolution = [16, 16]\nfilter = \"box\"\n[integrator]\ntype = \"depth\"\n\
+         [camera]\neye = [0.0, 0.0, 2.0]\ntarget = [0.0, 0.0, 0.0]\n\
+         [[shapes]]\ntype = \"mesh\"\nfile = \"grid.obj\"\n",
+    );
+    let mut images = Vec::new();
+    for threads in ["1", "3"] {
+        let out = dir.join(format!("t{threads}.exr"));
+        let (code, _, stderr) = run(&[
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--spp",
+            "2",
+            "--threads",
+            threads,
+        ]);
+        assert_eq!(code, 0, "{stderr}");
+        images.push(std::fs::read(&out).unwrap());
+    }
+    assert!(
+        images[0] == images[1],
+        "EXR bytes differ between 1 and 3 threads"
+    );
+    let (image, _) = obscura_render::read_exr(&dir.join("t1.exr")).unwrap();
+    // Pixels 4..12 lie over the grid (the image spans [-2, 2] at the grid's distance); the
+    // corners see nothing.
+    for y in 4..12 {
+        for x in 4..12 {
+            let p = image.pixel(x, y);
+            assert!(
+                p[3] == 1.0 && p[0] >= 2.0 && p[0] < 2.0 * 3f32.sqrt(),
+                "({x}, {y}): {p:?}"
+            );
+        }
+    }
+    assert_eq!(image.pixel(0, 0)[3], 0.0);
+}
+
 #[test]
 fn a_scene_file_in_another_folder_finds_its_mesh_relative_to_itself() {
     let dir = scratch("relative");
