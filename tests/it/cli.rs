@@ -172,26 +172,34 @@ fn render_writes_the_default_output_and_a_summary() {
     );
 }
 
+/// Renders `scene` at 3 spp with `args` and `--threads threads` to `dir/t{threads}.exr`, which
+/// must succeed; returns the EXR's bytes and the command's stderr.
+fn render_on(scene: &Path, dir: &Path, threads: &str, args: &[&str]) -> (Vec<u8>, String) {
+    let out = dir.join(format!("t{threads}.exr"));
+    let (scene, out_arg) = (scene.to_str().unwrap(), out.to_str().unwrap());
+    let mut all = vec![
+        "render",
+        scene,
+        "-o",
+        out_arg,
+        "--spp",
+        "3",
+        "--threads",
+        threads,
+    ];
+    all.extend_from_slice(args);
+    let (code, _, stderr) = run(&all);
+    assert_eq!(code, 0, "{stderr}");
+    (std::fs::read(&out).unwrap(), stderr)
+}
+
 #[test]
 fn output_is_bit_identical_for_any_thread_count() {
     let dir = scratch("threads");
     let scene = root().join("scenes").join("spheres-thin-lens.toml");
     let mut images = Vec::new();
     for threads in ["1", "2", "3", "100000"] {
-        let out = dir.join(format!("t{threads}.exr"));
-        let (code, _, stderr) = run(&[
-            "render",
-            scene.to_str().unwrap(),
-            "-o",
-            out.to_str().unwrap(),
-            "--resolution",
-            "40x30",
-            "--spp",
-            "3",
-            "--threads",
-            threads,
-        ]);
-        assert_eq!(code, 0, "{stderr}");
+        let (image, stderr) = render_on(&scene, &dir, threads, &["--resolution", "40x30"]);
         // Far more threads than cores are capped, with a note (starting 100000 threads would
         // take minutes); the image is the same.
         assert_eq!(
@@ -199,7 +207,7 @@ fn output_is_bit_identical_for_any_thread_count() {
             stderr.contains("capped at"),
             "{stderr}"
         );
-        images.push(std::fs::read(&out).unwrap());
+        images.push(image);
     }
     assert!(
         images.windows(2).all(|w| w[0] == w[1]),
@@ -240,26 +248,9 @@ fn a_large_mesh_gives_the_same_image_on_any_number_of_threads() {
          [camera]\neye = [0.0, 0.0, 2.0]\ntarget = [0.0, 0.0, 0.0]\n\
          [[shapes]]\ntype = \"mesh\"\nfile = \"grid.obj\"\n",
     );
-    let mut images = Vec::new();
-    for threads in ["1", "3"] {
-        let out = dir.join(format!("t{threads}.exr"));
-        let (code, _, stderr) = run(&[
-            "render",
-            scene.to_str().unwrap(),
-            "-o",
-            out.to_str().unwrap(),
-            "--spp",
-            "2",
-            "--threads",
-            threads,
-        ]);
-        assert_eq!(code, 0, "{stderr}");
-        images.push(std::fs::read(&out).unwrap());
-    }
-    assert!(
-        images[0] == images[1],
-        "EXR bytes differ between 1 and 3 threads"
-    );
+    let (one, _) = render_on(&scene, &dir, "1", &[]);
+    let (three, _) = render_on(&scene, &dir, "3", &[]);
+    assert!(one == three, "EXR bytes differ between 1 and 3 threads");
     let (image, _) = obscura_render::read_exr(&dir.join("t1.exr")).unwrap();
     // Pixels 4..12 lie over the grid (the image spans [-2, 2] at the grid's distance); the
     // corners see nothing.

@@ -158,7 +158,10 @@ impl SceneBuilder {
 
     /// Builds the BVHs: one over every static mesh triangle, flattened to world space; one per
     /// distinct moving mesh, in object space; and a top-level one over the flattened triangles,
-    /// the spheres, the quads and the moving meshes (each bounded over all times).
+    /// the spheres, the quads and the moving meshes (each bounded over all times). The
+    /// surface-area builds run their large subtrees on rayon's current pool (the global one
+    /// unless called inside [`rayon::ThreadPool::install`]); the trees are the same for any
+    /// number of threads.
     pub fn build(self) -> Result<Scene, AccelError> {
         let binary = self.quality.binary();
         let instance_count = self.instances.len();

@@ -137,14 +137,7 @@ fn fill(
         return fill_here(inputs, range, begin, bin, out);
     }
     let mut scratch = Box::new([[Bin::EMPTY; MAX_BINS]; 3]);
-    let (left, right) = split(
-        range,
-        inputs.aabbs,
-        inputs.centers,
-        &bin,
-        inputs.bins,
-        &mut scratch,
-    );
+    let (left, right) = split(range, inputs, &bin, &mut scratch);
     drop(scratch);
     let first = out.len();
     out.extend([Bvh2Node::default(); 2]);
@@ -211,14 +204,7 @@ fn fill_here(
         let node = if hi - lo <= MAX_LEAF {
             Bvh2Node::new(bin.bounds, (hi - lo) as u32, (begin + lo) as u32)
         } else {
-            let (left, right) = split(
-                &mut range[lo..hi],
-                inputs.aabbs,
-                inputs.centers,
-                &bin,
-                inputs.bins,
-                &mut scratch,
-            );
+            let (left, right) = split(&mut range[lo..hi], inputs, &bin, &mut scratch);
             let first = out.len();
             out.extend([Bvh2Node::default(); 2]);
             let mid = lo + left.count as usize;
@@ -273,21 +259,20 @@ impl Side {
 }
 
 /// Splits `range` (more than [`MAX_LEAF`] boxes, `all` their bin) by the cheapest of the
-/// planes between `bins` centroid bins on each axis, reordering it so the left side comes
+/// planes between `inputs.bins` centroid bins on each axis, reordering it so the left side comes
 /// first; returns the two sides' bins. Where no plane separates the centroids (they all
 /// coincide), the range is halved at a multiple of [`BLOCK`].
 ///
 /// Only planes between two occupied bins are costed, one per run of empty bins: every plane
 /// of such a run leaves the same boxes on each side, so it has the same cost, and the first
 /// cheapest plane found is the same. Most splits are of a few boxes in mostly empty bins.
-fn split(
-    range: &mut [u32],
-    aabbs: &[Aabb],
-    centers: &[Vec3A],
-    all: &Bin,
-    bins: usize,
-    scratch: &mut Scratch,
-) -> (Bin, Bin) {
+fn split(range: &mut [u32], inputs: &Inputs, all: &Bin, scratch: &mut Scratch) -> (Bin, Bin) {
+    let Inputs {
+        aabbs,
+        centers,
+        bins,
+        ..
+    } = *inputs;
     let extent = all.centroids.diagonal();
     // Centroid to bin: (c - min) * scale, below `bins` for every centroid in the range.
     let scale = Vec3A::select(
@@ -453,7 +438,7 @@ mod tests {
     }
 
     proptest::proptest! {
-        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(24))]
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(32))]
 
         /// Built in parallel, on one thread or three, the tree is the one-thread build's
         /// node for node, and a valid tree.
@@ -475,6 +460,35 @@ mod tests {
                 let leaves = check(&alone, &aabbs, &prims);
                 proptest::prop_assert_eq!(leaves.iter().sum::<u32>() as usize, n);
             }
+        }
+
+
+        /// The plane `split` chooses from its bins, costing one plane per run of empty bins,
+        /// is the one costing every plane from the boxes themselves chooses: the same boxes
+        /// below it, and the two sides' bins are those of their boxes, bit for bit.
+        #[test]
+        fn split_matches_every_plane_costed(
+            n in 5usize..300,
+            seed in proptest::prelude::any::<u64>(),
+            bins in proptest::prelude::prop_oneof![Just(2usize), Just(7), Just(32), Just(64)],
+        ) {
+            let aabbs = scattered(n, seed);
+            let centers: Vec<Vec3A> = aabbs.iter().map(Aabb::center).collect();
+            let mut range: Vec<u32> = (0..n as u32).collect();
+            let all = Bin::of(&range, &aabbs, &centers);
+            let expected = left_by_brute_force(&range, &aabbs, &centers, &all, bins);
+            let mut scratch = Box::new([[Bin::EMPTY; MAX_BINS]; 3]);
+            let inputs = Inputs { aabbs: &aabbs, centers: &centers, bins, parallel_min: usize::MAX };
+            let (left, right) = split(&mut range, &inputs, &all, &mut scratch);
+            let (below, above) = range.split_at(left.count as usize);
+            if let Some(mut expected) = expected {
+                let mut below = below.to_vec();
+                below.sort_unstable();
+                expected.sort_unstable();
+                proptest::prop_assert_eq!(below, expected);
+            }
+            proptest::prop_assert_eq!(bin_bits(&left), bin_bits(&Bin::of(below, &aabbs, &centers)));
+            proptest::prop_assert_eq!(bin_bits(&right), bin_bits(&Bin::of(above, &aabbs, &centers)));
         }
     }
 
@@ -545,37 +559,6 @@ mod tests {
         f[6..9].copy_from_slice(&c.min.to_array());
         f[9..].copy_from_slice(&c.max.to_array());
         (f.map(f32::to_bits), bin.count)
-    }
-
-    proptest::proptest! {
-        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(64))]
-
-        /// The plane `split` chooses from its bins, costing one plane per run of empty bins,
-        /// is the one costing every plane from the boxes themselves chooses: the same boxes
-        /// below it, and the two sides' bins are those of their boxes, bit for bit.
-        #[test]
-        fn split_matches_every_plane_costed(
-            n in 5usize..300,
-            seed in proptest::prelude::any::<u64>(),
-            bins in proptest::prelude::prop_oneof![Just(2usize), Just(7), Just(32), Just(64)],
-        ) {
-            let aabbs = scattered(n, seed);
-            let centers: Vec<Vec3A> = aabbs.iter().map(Aabb::center).collect();
-            let mut range: Vec<u32> = (0..n as u32).collect();
-            let all = Bin::of(&range, &aabbs, &centers);
-            let expected = left_by_brute_force(&range, &aabbs, &centers, &all, bins);
-            let mut scratch = Box::new([[Bin::EMPTY; MAX_BINS]; 3]);
-            let (left, right) = split(&mut range, &aabbs, &centers, &all, bins, &mut scratch);
-            let (below, above) = range.split_at(left.count as usize);
-            if let Some(mut expected) = expected {
-                let mut below = below.to_vec();
-                below.sort_unstable();
-                expected.sort_unstable();
-                proptest::prop_assert_eq!(below, expected);
-            }
-            proptest::prop_assert_eq!(bin_bits(&left), bin_bits(&Bin::of(below, &aabbs, &centers)));
-            proptest::prop_assert_eq!(bin_bits(&right), bin_bits(&Bin::of(above, &aabbs, &centers)));
-        }
     }
 
     /// Twelve unit cubes side by side along x, worked by hand. A row of n cubes has half area
