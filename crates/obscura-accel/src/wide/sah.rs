@@ -130,15 +130,11 @@ fn fill(
     out: &mut Vec<Bvh2Node>,
     forks: u32,
 ) -> Bvh2Node {
-    if range.len() <= MAX_LEAF {
-        return Bvh2Node::new(bin.bounds, range.len() as u32, begin as u32);
-    }
+    // A leaf is below `parallel_min` (at least MAX_LEAF + 1), so `fill_here` makes it.
     if range.len() < inputs.parallel_min || forks == 0 {
         return fill_here(inputs, range, begin, bin, out);
     }
-    let mut scratch = Box::new([[Bin::EMPTY; MAX_BINS]; 3]);
-    let (left, right) = split(range, inputs, &bin, &mut scratch);
-    drop(scratch);
+    let (left, right) = split(range, inputs, &bin, &mut empty_scratch());
     let first = out.len();
     out.extend([Bvh2Node::default(); 2]);
     let mid = left.count as usize;
@@ -186,7 +182,7 @@ fn fill_here(
     out: &mut Vec<Bvh2Node>,
 ) -> Bvh2Node {
     let mut root = Bvh2Node::default();
-    let mut scratch = Box::new([[Bin::EMPTY; MAX_BINS]; 3]);
+    let mut scratch = empty_scratch();
     // Slot `usize::MAX` is the range's own node, returned rather than stored.
     let mut pending = vec![Pending {
         slot: usize::MAX,
@@ -233,6 +229,11 @@ fn fill_here(
 
 /// Each axis's bins, kept between splits so that a split resets only the bins it uses.
 type Scratch = [[Bin; MAX_BINS]; 3];
+
+/// Bins for [`split`] to fill, on the heap (15 KB).
+fn empty_scratch() -> Box<Scratch> {
+    Box::new([[Bin::EMPTY; MAX_BINS]; 3])
+}
 
 /// The bounds and count of a run of bins: all that a side's cost reads.
 #[derive(Clone, Copy)]
@@ -477,7 +478,7 @@ mod tests {
             let mut range: Vec<u32> = (0..n as u32).collect();
             let all = Bin::of(&range, &aabbs, &centers);
             let expected = left_by_brute_force(&range, &aabbs, &centers, &all, bins);
-            let mut scratch = Box::new([[Bin::EMPTY; MAX_BINS]; 3]);
+            let mut scratch = empty_scratch();
             let inputs = Inputs {
                 aabbs: &aabbs,
                 centers: &centers,
