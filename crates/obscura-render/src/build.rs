@@ -184,6 +184,7 @@ impl RenderScene {
         let mut shading = ShadingScene::new(materials, instance_material, lights, emitters)
             .map_err(|e| d.error("lights", e.to_string()))?;
         shading.aim_at_specular(placed.iter().map(|(i, s, p)| (*i, s, p)));
+        shading.solve_through_glass(placed.iter().map(|(i, s, p)| (*i, s, p)));
         let sampler = Sampler::new(d.sampler.kind, d.sampler.spp, d.sampler.seed)
             .map_err(|e| d.error("sampler", e.to_string()))?;
         let filter = Filter::new(d.film.filter);

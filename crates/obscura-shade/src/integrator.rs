@@ -4,12 +4,13 @@
 use crate::error::ShadeError;
 use crate::frame::Frame;
 use crate::guide::{self, Aim, Casters};
+use crate::lens::{Chain, Lenses};
 use crate::light::{AreaLight, Light};
 use crate::material::{BsdfSample, Material};
 use glam::{Vec2, Vec3};
-use obscura_accel::{Hit, Placement, Scene, Shape};
+use obscura_accel::{Hit, Placement, SHADOW_EPSILON, Scene, Shape};
 use obscura_sample::{ONE_MINUS_EPSILON, SampleStream, SearchStart};
-use obscura_space::{Ray, Vector3, World};
+use obscura_space::{Point3, Ray, Vector3, World};
 
 /// The canonical numbers a path consumes, one shading decision after another. Implemented by
 /// [`obscura_sample::SampleStream`]; tests may plug in their own generator.
@@ -93,6 +94,10 @@ pub struct ShadingScene {
     environment: Vec<u32>,
     /// The smooth specular objects diffuse vertices aim a share of their samples at.
     casters: Casters,
+    /// The glass balls diffuse vertices solve light paths through.
+    lenses: Lenses,
+    /// Whether any vertex solves through them: there are balls and a light they solve for.
+    solves: bool,
 }
 
 impl ShadingScene {
@@ -155,6 +160,8 @@ impl ShadingScene {
             instance_light,
             environment,
             casters: Casters::default(),
+            lenses: Lenses::default(),
+            solves: false,
         })
     }
 
@@ -176,6 +183,38 @@ impl ShadingScene {
                 .filter_map(|(i, shape, placement)| Some((self.material(i)?, shape, placement))),
         );
         self.casters = casters;
+    }
+
+    /// Makes the vertices near a static ball of smooth glass among `instances` (`(instance,
+    /// shape, placement)`, numbered as for [`ShadingScene::new`]) solve for the light that
+    /// reaches them through it: a vertex that samples a point on a static quad light also
+    /// finds every path that refracts into the ball and out of it to that point, and adds its
+    /// light (manifold next-event estimation for the one chain of a sphere, weighed by MIS
+    /// against the vertex's BSDF samples that find the same paths). The caustic a ball throws on
+    /// the surfaces near it is found from every vertex there, not only by the rare BSDF
+    /// sample that leaves the ball towards the light. Balls: spheres placed by a similarity,
+    /// index above 1, at most four (the largest); vertices within two radii of a centre.
+    /// Without this call nothing is solved for.
+    pub fn solve_through_glass<'a>(
+        &mut self,
+        instances: impl IntoIterator<Item = (u32, &'a Shape, &'a Placement)>,
+    ) {
+        let lenses =
+            Lenses::new(instances.into_iter().filter_map(|(i, shape, placement)| {
+                Some((i, self.material(i)?, shape, placement))
+            }));
+        let quad_light = self
+            .lights
+            .iter()
+            .any(|l| matches!(l, Light::Area(a) if a.is_fixed_quad()));
+        self.solves = lenses.len() > 0 && quad_light;
+        self.lenses = lenses;
+    }
+
+    /// How many glass balls vertices solve light paths through
+    /// ([`ShadingScene::solve_through_glass`]).
+    pub fn lens_count(&self) -> usize {
+        self.lenses.len()
     }
 
     /// How many objects diffuse vertices aim samples at ([`ShadingScene::aim_at_specular`]).
@@ -279,11 +318,12 @@ pub struct PathIntegrator {
 /// Which values the path tracer gives for the same scene and random numbers: raised whenever
 /// its estimator changes (1 before diffuse vertices aimed at casters, 2 once they did, 3 since
 /// Russian roulette sees an aimed sample's throughput without the aim's weight, 4 since moving
-/// glass and mirrors are aimed at too). Films made by
+/// glass and mirrors are aimed at too, 5 since vertices near glass balls solve for the light
+/// through them). Films made by
 /// a build with another estimator are unbiased but not this build's image, so the renderer's
 /// scene fingerprint includes this number, as it includes the samplers'
 /// `obscura_sample::SEQUENCE_VERSION`.
-pub const ESTIMATOR_VERSION: u32 = 4;
+pub const ESTIMATOR_VERSION: u32 = 5;
 
 /// Densities below this are treated as zero (the path ends instead of dividing by them).
 const MIN_PDF: f32 = 1e-12;
@@ -414,7 +454,8 @@ impl PathIntegrator {
                     prefetch_searched(search);
                 }
                 let found = ahead.get(k).copied().unwrap_or_default();
-                let (shadow, more) = self.vertex(shading, path, hit, found, &mut dims[*slot]);
+                let (shadow, more) =
+                    self.vertex(geometry, shading, path, hit, found, &mut dims[*slot]);
                 if let Some(shadow) = shadow {
                     pending.push((k, shadow));
                 }
@@ -452,7 +493,8 @@ impl PathIntegrator {
         };
         loop {
             let hit = geometry.intersect(&path.ray);
-            let (shadow, more) = self.vertex(shading, &mut path, hit, Ahead::default(), dims);
+            let (shadow, more) =
+                self.vertex(geometry, shading, &mut path, hit, Ahead::default(), dims);
             if let Some(shadow) = shadow {
                 let blocked = geometry.occluded(&shadow.ray);
                 path.add_light(shadow, blocked);
@@ -470,6 +512,7 @@ impl PathIntegrator {
     #[inline(always)]
     fn vertex(
         &self,
+        geometry: &Scene,
         shading: &ShadingScene,
         path: &mut PathState,
         hit: Option<Hit>,
@@ -502,7 +545,12 @@ impl PathIntegrator {
         if let Some(area) = shading.area_light(hit.instance) {
             let le = area.emitted(n_geometric, wo_world);
             if le != Vec3::ZERO {
-                let weight = if path.specular_bounce {
+                let weight = if let Through::Left(k) = path.through {
+                    // The end of a chain through a glass ball from a vertex that solved for
+                    // such chains: weighed against the solve's chance of it.
+                    path.via
+                        .weight(shading, area, k, hit.p.to_glam(), n_geometric.dot(wo_world))
+                } else if path.specular_bounce {
                     1.0
                 } else {
                     let pdf_light = light_select
@@ -534,10 +582,20 @@ impl PathIntegrator {
 
         // A diffuse vertex of a path's first bounces, in a scene with casters, aims part of
         // its samples at them.
-        let aim = (path.depth < guide::AIMED_DEPTH && aims(shading, material)).then(|| {
-            let n = if wo.z < 0.0 { -frame.n } else { frame.n };
-            shading.casters.at(hit.p.to_glam(), n)
-        });
+        let n_side = if wo.z < 0.0 { -frame.n } else { frame.n };
+        let aim = (path.depth < guide::AIMED_DEPTH && aims(shading, material))
+            .then(|| shading.casters.at(hit.p.to_glam(), n_side));
+        // The glass balls this vertex solves light paths through, if any: only where the
+        // chain's two refractions and the light fit within the depth limit, as a BSDF sample's
+        // would.
+        let near = if shading.solves
+            && path.depth + 3 <= self.max_depth
+            && shading.samples_light_on(material)
+        {
+            shading.lenses.near(hit.p.to_glam(), n_side)
+        } else {
+            0
+        };
 
         // Next-event estimation: one light, chosen uniformly.
         let mut shadow = None;
@@ -567,6 +625,20 @@ impl PathIntegrator {
                 }
                 None => path.radiance += path.beta * Vec3::ZERO,
             }
+            if near != 0 {
+                path.radiance += path.beta
+                    * through_glass(
+                        geometry,
+                        shading,
+                        &hit,
+                        material,
+                        &frame,
+                        wo,
+                        aim.as_ref(),
+                        near,
+                        numbers,
+                    );
+            }
         }
 
         // Continue the path by sampling the BSDF.
@@ -588,6 +660,19 @@ impl PathIntegrator {
             return (shadow, false);
         }
         path.beta *= throughput;
+        path.through = if near != 0 {
+            path.via = Via {
+                x: hit.p.to_glam(),
+                wi: frame.from_local(bs.wi),
+                pdf: bs.pdf,
+            };
+            Through::From(near)
+        } else if shading.solves && material.is_specular() {
+            path.through
+                .after(shading.lenses.index_of(hit.instance), bs.eta)
+        } else {
+            Through::Nothing
+        };
         path.specular_bounce = bs.specular;
         path.prev_pdf = bs.pdf;
         path.prev_p = hit.p.to_glam();
@@ -822,6 +907,10 @@ struct PathState {
     /// scaling and the aims' weights, which Russian roulette must not see.
     rr_scale: f32,
     camera_ray_hit: bool,
+    /// Where the path stands on a chain through a glass ball from a vertex that solved
+    /// through it, and that vertex.
+    through: Through,
+    via: Via,
 }
 
 impl PathState {
@@ -840,6 +929,8 @@ impl PathState {
             depth: 0,
             rr_scale: 1.0,
             camera_ray_hit: false,
+            through: Through::Nothing,
+            via: Via::default(),
         })
     }
 
@@ -899,4 +990,143 @@ fn spawn_ray_to(hit: &Hit, target: Vec3) -> Ray<World> {
     let mut ray = hit.spawn_ray_to(obscura_space::Point3::from_glam(target));
     ray.time = hit.time;
     ray
+}
+
+/// Where a path stands on a chain `x -> ball -> ball -> light` from a vertex `x` that solved
+/// for such chains ([`ShadingScene::solve_through_glass`]): the emission at the end of one is
+/// already counted.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Through {
+    /// On no such chain.
+    Nothing,
+    /// Leaving a vertex that solved through the balls of this mask.
+    From(u8),
+    /// Refracted into ball `k` from such a vertex.
+    Inside(u8),
+    /// Refracted out of ball `k` again: the next surface, if it is the light, ends the chain.
+    Left(u8),
+}
+
+impl Through {
+    /// The state after a specular vertex on ball `ball` (if it is one) that scattered with
+    /// the refraction ratio `eta` (above 1 entering glass, below 1 leaving, 1 reflecting).
+    #[inline]
+    fn after(self, ball: Option<usize>, eta: f32) -> Through {
+        match (self, ball) {
+            (Through::From(mask), Some(k)) if mask & (1 << k) != 0 && eta > 1.0 => {
+                Through::Inside(k as u8)
+            }
+            (Through::Inside(j), Some(k)) if j as usize == k && eta < 1.0 => Through::Left(j),
+            _ => Through::Nothing,
+        }
+    }
+}
+
+/// The vertex a path solved through glass balls from: where it was, the direction its BSDF
+/// sample left along, and that sample's density.
+#[derive(Clone, Copy, Debug, Default)]
+struct Via {
+    x: Vec3,
+    wi: Vec3,
+    pdf: f32,
+}
+
+impl Via {
+    /// The MIS weight of a BSDF-sampled path that went from this vertex through ball `k` to
+    /// the point `y` on `area`, arriving at cosine `cos_y` there: the power heuristic of the sample's
+    /// density times the two refractions' chance, `p_bsdf T`, against the solve's density
+    /// for the same direction, `p(y) / (d_omega / dA)`. 1 for a light the solve does not
+    /// sample or a chain it would not find.
+    fn weight(&self, shading: &ShadingScene, area: &AreaLight, k: u8, y: Vec3, cos_y: f32) -> f32 {
+        let Some(pdf_area) = area.fixed_quad_pdf() else {
+            return 1.0;
+        };
+        let Some((per_area, transmittance)) =
+            shading.lenses.density_along(k as usize, self.x, self.wi, y)
+        else {
+            return 1.0;
+        };
+        let p_solve = pdf_area * shading.light_select_pdf() / (per_area * cos_y);
+        power_heuristic(self.pdf * transmittance, p_solve)
+    }
+}
+
+/// The light reaching the vertex at `hit` through the glass balls of `near` from the point
+/// that the light sample's `numbers` pick on a static quad light: the sum over the chains
+/// to it of `f cos T L_e (d_omega / dA) / p(y)`, each chain whose three segments are clear,
+/// weighed by MIS against the vertex's BSDF sample (`aim`: the vertex's mixture, if it aims)
+/// finding the same chain (zero when the numbers pick another kind of light, whose chains
+/// the BSDF samples count).
+#[inline(never)]
+fn through_glass(
+    geometry: &Scene,
+    shading: &ShadingScene,
+    hit: &Hit,
+    material: &Material,
+    frame: &Frame,
+    wo: Vec3,
+    aim: Option<&Aim>,
+    near: u8,
+    numbers: LightNumbers,
+) -> Vec3 {
+    let count = shading.lights.len();
+    let Light::Area(area) = &shading.lights[light_index(numbers.choice, count)] else {
+        return Vec3::ZERO;
+    };
+    let Some((y, n_y, pdf_area)) = area.fixed_quad_point(numbers.pair) else {
+        return Vec3::ZERO;
+    };
+    let p_y = pdf_area / count as f32;
+    let x = hit.p.to_glam();
+    let mut sum = Vec3::ZERO;
+    for k in 0..shading.lenses.len() {
+        if near & (1 << k) == 0 {
+            continue;
+        }
+        shading.lenses.chains(k, x, y, |chain| {
+            let cos_y = n_y.dot(-chain.exit);
+            let le = area.emitted(n_y, -chain.exit);
+            let wi = frame.to_local(chain.wi);
+            let f = material.eval(wo, wi) * wi.z.abs();
+            if cos_y <= 0.0 || le == Vec3::ZERO || f == Vec3::ZERO {
+                return;
+            }
+            let per_area = chain.solid_angle_per_area * cos_y;
+            let mut pdf_bsdf = material.pdf(wo, wi);
+            if let Some(aim) = aim {
+                pdf_bsdf = aim.mixture_pdf(chain.wi, pdf_bsdf, None);
+            }
+            let weight = power_heuristic(p_y / per_area, pdf_bsdf * chain.transmittance);
+            if weight > 0.0 && !blocked(geometry, hit, chain, y) {
+                sum += f * le * (chain.transmittance * per_area / p_y * weight);
+            }
+        });
+    }
+    sum
+}
+
+/// Whether something stops a chain: between the vertex and the ball, inside the ball, or
+/// between the ball and the light. The segments end a ten-thousandth of the radius off the
+/// sphere, on their own side of it, so that the ball itself does not stop them.
+fn blocked(geometry: &Scene, hit: &Hit, chain: &Chain, y: Vec3) -> bool {
+    let margin = chain.margin;
+    let to_ball = spawn_ray_to(hit, chain.p1 + margin * chain.n1);
+    if geometry.occluded(&to_ball) {
+        return true;
+    }
+    let a = chain.p1 - margin * chain.n1;
+    let b = chain.p2 - margin * chain.n2;
+    let inside =
+        Ray::new(Point3::from_glam(a), Vector3::from_glam(b - a), hit.time).with_range(0.0, 1.0);
+    if geometry.occluded(&inside) {
+        return true;
+    }
+    let out = chain.p2 + margin * chain.n2;
+    let to_light = Ray::new(
+        Point3::from_glam(out),
+        Vector3::from_glam(y - out),
+        hit.time,
+    )
+    .with_range(0.0, 1.0 - SHADOW_EPSILON);
+    geometry.occluded(&to_light)
 }

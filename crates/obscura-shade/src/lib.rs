@@ -68,6 +68,7 @@ mod error;
 mod frame;
 mod guide;
 mod integrator;
+mod lens;
 mod light;
 mod material;
 

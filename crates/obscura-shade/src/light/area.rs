@@ -186,6 +186,32 @@ impl AreaLight {
         }
     }
 
+    /// Whether this light is a static quad, whose samples are points by area whatever the
+    /// reference point: the light that vertices solve paths through glass balls to.
+    #[inline]
+    pub(crate) fn is_fixed_quad(&self) -> bool {
+        matches!(self.fixed.as_deref(), Some(Placed::Quad(_)))
+    }
+
+    /// For a static quad, the point [`AreaLight::sample_li`] picks with `u2`: the point, the
+    /// unit normal on the emitting side and the density per unit area.
+    #[inline]
+    pub(crate) fn fixed_quad_point(&self, u2: Vec2) -> Option<(Vec3, Vec3, f32)> {
+        match self.fixed.as_deref() {
+            Some(Placed::Quad(quad)) => quad.sample(u2).map(|s| (s.p, s.n, s.pdf_area)),
+            _ => None,
+        }
+    }
+
+    /// For a static quad, its density per unit area (one over its area).
+    #[inline]
+    pub(crate) fn fixed_quad_pdf(&self) -> Option<f32> {
+        match self.fixed.as_deref() {
+            Some(Placed::Quad(quad)) => quad.pdf_area,
+            _ => None,
+        }
+    }
+
     /// Samples a direction from `p_ref` towards this light at `time`.
     pub fn sample_li(&self, p_ref: Vec3, time: f32, u2: Vec2) -> Option<LightSample> {
         // Quads, ellipsoids and meshes: a point by area, converted to solid angle; spheres

@@ -67,7 +67,7 @@ pub(super) fn normal_matrix(world_from_object: &Transform<World, Object>) -> Mat
 
 /// `+1` for orientation-preserving maps, `-1` for mirroring ones: `(Ma) x (Mb) = det(M) M^-T (a x b)`,
 /// so cross products of mapped edges point against the (inverse-transpose) normal when `det < 0`.
-pub(super) fn orientation_sign(m: &Mat4) -> f32 {
+pub(crate) fn orientation_sign(m: &Mat4) -> f32 {
     if Mat3::from_mat4(*m).determinant() < 0.0 {
         -1.0
     } else {
