@@ -52,8 +52,14 @@ use obscura_accel::{Placement, Shape};
 /// bounded.
 pub(crate) const MAX_LENSES: usize = 4;
 
-/// Steps of the impact parameter on which the roots are bracketed.
-const SCAN: usize = 16;
+/// Steps of the impact parameter on which the roots are bracketed. Two roots within one step
+/// lie next to a fold, where the solve's MIS weight is small (module docs); sixteen steps
+/// gave the same error on the Cornell box as eight, at more cost.
+const SCAN: usize = 8;
+
+/// The refinement stops when a step moves the root by less than this (in radii): the
+/// density's central differences (a step of 1e-6) need no more.
+const ROOT_TOLERANCE: f64 = 1e-10;
 
 /// `(radius / distance)^2` from which a ball is solved through: within two radii of its
 /// centre. A ball lens of glass focuses light from afar at 1.5 radii from its centre, and
@@ -351,15 +357,17 @@ impl Plane {
     /// the false position method, which converges superlinearly and stays bracketed).
     fn refine(&self, mut a: f64, mut ga: f64, mut b: f64, mut gb: f64) -> f64 {
         let mut side = 0;
+        let mut last = f64::NAN;
         for _ in 0..60 {
             if gb == ga {
                 break;
             }
             let c = (a * gb - b * ga) / (gb - ga);
             let gc = self.miss(c);
-            if gc == 0.0 || !gc.is_finite() || (b - a).abs() < 1e-13 {
+            if gc == 0.0 || !gc.is_finite() || (c - last).abs() < ROOT_TOLERANCE {
                 return c;
             }
+            last = c;
             if (gc < 0.0) == (gb < 0.0) {
                 b = c;
                 gb = gc;
