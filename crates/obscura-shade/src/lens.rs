@@ -64,7 +64,7 @@ const ROOT_TOLERANCE: f64 = 1e-10;
 /// `(radius / distance)^2` from which a ball is solved through: within two radii of its
 /// centre. A ball lens of glass focuses light from afar at 1.5 radii from its centre, and
 /// further out the caustic is spread and dim enough for the BSDF's samples (and aiming).
-const REACH_SIN2: f64 = 1.0 / 4.0;
+const REACH_SIN2: f32 = 1.0 / 4.0;
 
 /// A static glass ball in world space.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -155,15 +155,15 @@ impl Lenses {
     /// through, one bit each: those within reach whose sphere is not wholly below the horizon.
     #[inline]
     pub(crate) fn near(&self, p: Vec3, n: Vec3) -> u8 {
-        let p = p.as_dvec3();
-        let n = n.as_dvec3();
         let mut mask = 0;
         for (k, ball) in self.list.iter().enumerate() {
-            let to_center = ball.center - p;
+            // In f32, like the vertex: a test of reach, not of the chain.
+            let to_center = ball.center.as_vec3() - p;
             let d2 = to_center.length_squared();
-            let r2 = ball.radius * ball.radius;
+            let r = ball.radius as f32;
+            let r2 = r * r;
             let outside = d2 > r2 * (1.0 + 1e-4) && d2.is_finite();
-            if outside && r2 >= REACH_SIN2 * d2 && to_center.dot(n) > -ball.radius {
+            if outside && r2 >= REACH_SIN2 * d2 && to_center.dot(n) > -r {
                 mask |= 1 << k;
             }
         }
@@ -289,33 +289,40 @@ impl Plane {
     /// (normal `-p2`, ratio `eta`), the chord between them `2 cos(theta_t)` long.
     #[inline]
     fn path(&self, b: f64) -> Option<PlanePath> {
-        let b = b.clamp(-1.0, 1.0);
-        let sin_alpha = b / self.d;
-        let cos_alpha = (1.0 - sin_alpha * sin_alpha).sqrt();
+        let path = self.trace(b.clamp(-1.0, 1.0));
+        path.u3.is_finite().then_some(path)
+    }
+
+    /// [`Plane::path`] for `b` in `[-1, 1]`, unchecked: the scan's and the refinement's
+    /// arithmetic (a NaN, which no finite input gives, fails their sign tests).
+    #[inline(always)]
+    fn trace(&self, b: f64) -> PlanePath {
+        let inv_eta = 1.0 / self.eta;
+        let sin_alpha = b * (1.0 / self.d);
+        let cos_alpha = (1.0 - sin_alpha * sin_alpha).max(0.0).sqrt();
         let u = DVec2::new(-cos_alpha, sin_alpha);
         let cos_i = (1.0 - b * b).max(0.0).sqrt();
-        let cos_t = (1.0 - b * b / (self.eta * self.eta)).max(0.0).sqrt();
+        let sin_t = b * inv_eta;
+        let cos_t = (1.0 - sin_t * sin_t).max(0.0).sqrt();
         let t1 = self.d * cos_alpha - cos_i;
         let p1 = DVec2::new(self.d, 0.0) + t1 * u;
-        let u2 = u / self.eta + (cos_i / self.eta - cos_t) * p1;
+        let u2 = u * inv_eta + (cos_i * inv_eta - cos_t) * p1;
         let p2 = p1 + 2.0 * cos_t * u2;
         let u3 = self.eta * u2 - (self.eta * cos_t - cos_i) * p2;
-        u3.is_finite().then_some(PlanePath {
+        PlanePath {
             u,
             p1,
             p2,
             u3,
             cos_i,
-        })
+        }
     }
 
     /// `g(b)`: the signed distance of `y` from the exit line of `b`.
-    #[inline]
+    #[inline(always)]
     fn miss(&self, b: f64) -> f64 {
-        match self.path(b) {
-            Some(p) => p.u3.perp_dot(self.y - p.p2),
-            None => f64::NAN,
-        }
+        let p = self.trace(b);
+        p.u3.perp_dot(self.y - p.p2)
     }
 
     /// `d_omega / dA_perp` of the chain of impact parameter `b` through a ball of radius `r`
