@@ -19,7 +19,10 @@
 //!   each per round, so that their rays reach the geometry in batches (faster on large
 //!   meshes, the same values bit for bit). After [`ShadingScene::aim_at_specular`], diffuse
 //!   vertices aim a share of their samples at the nearby glass and mirrors, so that the
-//!   caustics those throw are found far more often (still unbiased).
+//!   caustics those throw are found far more often (still unbiased); after
+//!   [`ShadingScene::solve_through_glass`], vertices near a glass ball solve for the paths
+//!   through it to their light sample's point on a quad light (manifold next-event
+//!   estimation), weighed by MIS against the BSDF samples that find the same paths.
 //!
 //! What is not here: geometry and ray queries (obscura-accel), cameras, films, scene files and
 //! image output (obscura-camera, obscura-render). Nothing here owns a random number generator.
