@@ -615,7 +615,14 @@ impl PathIntegrator {
                     map_row: None,
                 },
             };
-            match self.sample_light(shading, &hit, material, &frame, wo, aim.as_ref(), numbers) {
+            let seen = Seen {
+                hit: &hit,
+                material,
+                frame: &frame,
+                wo,
+                aim: aim.as_ref(),
+            };
+            match self.sample_light(shading, seen, numbers) {
                 Some((value, ray)) => {
                     shadow = Some(Shadow {
                         beta: path.beta,
@@ -626,18 +633,7 @@ impl PathIntegrator {
                 None => path.radiance += path.beta * Vec3::ZERO,
             }
             if near != 0 {
-                path.radiance += path.beta
-                    * through_glass(
-                        geometry,
-                        shading,
-                        &hit,
-                        material,
-                        &frame,
-                        wo,
-                        aim.as_ref(),
-                        near,
-                        numbers,
-                    );
+                path.radiance += path.beta * through_glass(geometry, shading, seen, near, numbers);
             }
         }
 
@@ -742,13 +738,10 @@ impl PathIntegrator {
     fn sample_light(
         &self,
         shading: &ShadingScene,
-        hit: &Hit,
-        material: &Material,
-        frame: &Frame,
-        wo: Vec3,
-        aim: Option<&Aim>,
+        seen: Seen,
         numbers: LightNumbers,
     ) -> Option<(Vec3, Ray<World>)> {
+        let hit = seen.hit;
         let count = shading.lights.len();
         let index = light_index(numbers.choice, count);
         let light_select = 1.0 / count as f32;
@@ -760,8 +753,7 @@ impl PathIntegrator {
         if ls.radiance == Vec3::ZERO || (!ls.delta && ls.pdf < MIN_PDF) {
             return None;
         }
-        let wi = frame.to_local(ls.wi);
-        let f = material.eval(wo, wi) * wi.z.abs();
+        let (f, wi) = seen.f_cos(ls.wi);
         if f == Vec3::ZERO {
             return None;
         }
@@ -774,11 +766,7 @@ impl PathIntegrator {
             f * ls.radiance / light_select
         } else {
             let pdf_light = light_select * ls.pdf;
-            let mut pdf_bsdf = material.pdf(wo, wi);
-            if let Some(aim) = aim {
-                pdf_bsdf = aim.mixture_pdf(ls.wi, pdf_bsdf, None);
-            }
-            let weight = power_heuristic(pdf_light, pdf_bsdf);
+            let weight = power_heuristic(pdf_light, seen.pdf(ls.wi, wi));
             f * ls.radiance * weight / pdf_light
         };
         Some((value, shadow))
@@ -1022,6 +1010,38 @@ impl Through {
     }
 }
 
+/// A vertex as its light samples see it: the hit, its material in its shading frame, the
+/// direction to the viewer in that frame, and the mixture its BSDF sample is drawn from if it
+/// aims at casters.
+#[derive(Clone, Copy)]
+struct Seen<'a> {
+    hit: &'a Hit,
+    material: &'a Material,
+    frame: &'a Frame,
+    wo: Vec3,
+    aim: Option<&'a Aim>,
+}
+
+impl Seen<'_> {
+    /// `f |cos|` for light arriving along the world direction `w`, and `w` in the local frame.
+    #[inline(always)]
+    fn f_cos(&self, w: Vec3) -> (Vec3, Vec3) {
+        let wi = self.frame.to_local(w);
+        (self.material.eval(self.wo, wi) * wi.z.abs(), wi)
+    }
+
+    /// The density with which the vertex's BSDF sample (aimed, if it aims) draws the world
+    /// direction `w` (`wi` in the local frame): the weight's other side for a light sample.
+    #[inline(always)]
+    fn pdf(&self, w: Vec3, wi: Vec3) -> f32 {
+        let pdf = self.material.pdf(self.wo, wi);
+        match self.aim {
+            Some(aim) => aim.mixture_pdf(w, pdf, None),
+            None => pdf,
+        }
+    }
+}
+
 /// The vertex a path solved through glass balls from: where it was, the direction its BSDF
 /// sample left along, and that sample's density.
 #[derive(Clone, Copy, Debug, Default)]
@@ -1061,14 +1081,11 @@ impl Via {
 fn through_glass(
     geometry: &Scene,
     shading: &ShadingScene,
-    hit: &Hit,
-    material: &Material,
-    frame: &Frame,
-    wo: Vec3,
-    aim: Option<&Aim>,
+    seen: Seen,
     near: u8,
     numbers: LightNumbers,
 ) -> Vec3 {
+    let hit = seen.hit;
     let count = shading.lights.len();
     let Light::Area(area) = &shading.lights[light_index(numbers.choice, count)] else {
         return Vec3::ZERO;
@@ -1086,16 +1103,12 @@ fn through_glass(
         shading.lenses.chains(k, x, y, |chain| {
             let cos_y = n_y.dot(-chain.exit);
             let le = area.emitted(n_y, -chain.exit);
-            let wi = frame.to_local(chain.wi);
-            let f = material.eval(wo, wi) * wi.z.abs();
+            let (f, wi) = seen.f_cos(chain.wi);
             if cos_y <= 0.0 || le == Vec3::ZERO || f == Vec3::ZERO {
                 return;
             }
             let per_area = chain.solid_angle_per_area * cos_y;
-            let mut pdf_bsdf = material.pdf(wo, wi);
-            if let Some(aim) = aim {
-                pdf_bsdf = aim.mixture_pdf(chain.wi, pdf_bsdf, None);
-            }
+            let pdf_bsdf = seen.pdf(chain.wi, wi);
             let weight = power_heuristic(p_y / per_area, pdf_bsdf * chain.transmittance);
             if weight > 0.0 && !blocked(geometry, hit, chain, y) {
                 sum += f * le * (chain.transmittance * per_area / p_y * weight);
