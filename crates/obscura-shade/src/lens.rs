@@ -41,7 +41,9 @@
 //! Near a fold of the chains (where the lens's own caustic meets the light) `d_omega / dA`
 //! grows without bound and the solve's weight goes to zero: the BSDF samples take those
 //! paths, and the solve has no fireflies. Roots closer together than a scan step lie next to
-//! such a fold; missing them loses only what the solve's small weight there would have added.
+//! such a fold and are missed together; the BSDF side still weighs such a path as if the solve
+//! had found it, so what the solve's small weight there would have added is lost: a small
+//! bias in a sliver along the lens's own caustic.
 
 use crate::light::solid_angle::{orientation_sign, world_sphere};
 use crate::material::{Material, fresnel_dielectric};
@@ -53,8 +55,7 @@ use obscura_accel::{Placement, Shape};
 pub(crate) const MAX_LENSES: usize = 4;
 
 /// Steps of the impact parameter on which the roots are bracketed. Two roots within one step
-/// lie next to a fold, where the solve's MIS weight is small (module docs); sixteen steps
-/// gave the same error on the Cornell box as eight, at more cost.
+/// lie next to a fold, where the solve's MIS weight is small (module docs).
 const SCAN: usize = 8;
 
 /// The refinement stops when a step moves the root by less than this (in radii): the
