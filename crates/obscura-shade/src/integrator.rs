@@ -981,8 +981,8 @@ fn spawn_ray_to(hit: &Hit, target: Vec3) -> Ray<World> {
 }
 
 /// Where a path stands on a chain `x -> ball -> ball -> light` from a vertex `x` that solved
-/// for such chains ([`ShadingScene::solve_through_glass`]): the emission at the end of one is
-/// already counted.
+/// for such chains ([`ShadingScene::solve_through_glass`]): the emission at the end of one
+/// is weighed against the solve's chance of the same path ([`Via::weight`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Through {
     /// On no such chain.
