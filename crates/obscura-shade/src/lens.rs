@@ -211,12 +211,12 @@ impl Lenses {
     pub(crate) fn density_along(&self, k: usize, x: Vec3, wi: Vec3, y: Vec3) -> Option<(f32, f32)> {
         let (ball, plane, e1, e2) = self.plane(k, x, y)?;
         let wi = wi.as_dvec3();
-        // The impact parameter: `u = (-cos(alpha), sin(alpha))`, `b = d sin(alpha)`.
-        let along = -wi.dot(e1);
-        let b = (plane.d * wi.dot(e2)).clamp(-1.0, 1.0);
-        if along <= 0.0 {
+        // The direction must head towards the centre; its impact parameter follows from
+        // `u = (-cos(alpha), sin(alpha))`, `b = d sin(alpha)`.
+        if wi.dot(e1) >= 0.0 {
             return None;
         }
+        let b = (plane.d * wi.dot(e2)).clamp(-1.0, 1.0);
         let path = plane.path(b)?;
         Some((
             plane.density(b, ball.radius)?,
