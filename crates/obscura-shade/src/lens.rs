@@ -446,10 +446,15 @@ mod tests {
                 prop_assert!((c.p1 - x).normalize().dot(c.wi) > 1.0 - tol, "{:?}", c);
                 prop_assert!(((c.p1 - center).length() / radius - 1.0).abs() < tol);
                 prop_assert!(((c.p2 - center).length() / radius - 1.0).abs() < tol);
-                let inside = refract(c.wi, c.n1, 1.0 / ior);
-                prop_assert!((c.p2 - c.p1).normalize().dot(inside) > 1.0 - tol, "{:?}", c);
-                let out = refract(inside, -c.n2, ior);
-                prop_assert!(out.dot(c.exit) > 1.0 - tol, "{:?}", c);
+                // At grazing entry the exit's `1 - eta^2 sin^2` is below f32's rounding of
+                // the chain's vectors, so Snell's law in f32 cannot check it; such a chain's
+                // transmittance is below 1e-3.
+                if -c.wi.dot(c.n1) > 1e-3 {
+                    let inside = refract(c.wi, c.n1, 1.0 / ior);
+                    prop_assert!((c.p2 - c.p1).normalize().dot(inside) > 1.0 - tol, "{:?}", c);
+                    let out = refract(inside, -c.n2, ior);
+                    prop_assert!(out.dot(c.exit) > 1.0 - tol, "{:?}", c);
+                }
                 prop_assert!((y - c.p2).normalize().dot(c.exit) > 1.0 - tol, "{:?}", c);
                 prop_assert!(c.solid_angle_per_area.is_finite() && c.solid_angle_per_area > 0.0);
                 prop_assert!((0.0..=1.0).contains(&c.transmittance));
