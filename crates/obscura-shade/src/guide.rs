@@ -8,9 +8,11 @@
 //! light's whole value, so the caustic is where such scenes keep their error (fireflies).
 //!
 //! At a diffuse vertex `p` where the camera ray or the first bounce lands ([`AIMED_DEPTH`]),
-//! caster `k` (a bounding sphere) gets the weight `w_k = min(1, sin^2(theta_k) / NEAR)`,
+//! caster `k` (a bounding sphere) gets the weight `w_k = f_k min(1, sin^2(theta_k) / NEAR)`,
 //! `theta_k` the half-angle of its cone seen from `p` (zero when `p` is inside it or the cone
-//! lies wholly below the horizon). The direction is drawn from the mixture
+//! lies wholly below the horizon), `f_k` its focus: 1 for glass, [`HALF_FOCUS`] for a mirror
+//! and for a glass ball that the vertices near it solve through for every light
+//! ([`crate::lens`]). The direction is drawn from the mixture
 //!
 //! `p_mix = (1 - a) p_bsdf + a sum_k (w_k / W) q_k`, with `W = sum_k w_k`, `a = SHARE min(1, W)`
 //!
@@ -22,6 +24,9 @@
 //! spreads what it reflects, so a caster's light is concentrated only near it: the weight
 //! falls with the square of the distance past twice the radius (`NEAR = 1/4`), and a vertex
 //! far from every caster samples its BSDF alone (docs/performance.md, "Aiming at casters").
+//! For the same reason a mirror takes half a glass ball's share; so does a glass ball whose
+//! focused light the vertices near it already solve for, where what aiming adds is the light
+//! it throws further away and along longer chains (docs/performance.md, "Half a share").
 
 use crate::frame::Frame;
 use crate::light::solid_angle::{cone_pdf, cone_sin2, one_minus_cos, world_sphere};
@@ -34,6 +39,10 @@ use obscura_space::{AnimatedTransform, Bounds3, Object, Point3, Transform, World
 
 /// The largest share of a diffuse vertex's BSDF samples aimed at casters.
 pub(crate) const SHARE: f32 = 0.5;
+
+/// The focus of a mirror, and of a glass ball solved through for every light: half a glass
+/// ball's.
+pub(crate) const HALF_FOCUS: f32 = 0.5;
 
 /// `sin^2` of a cone's half-angle from which a caster gets its full weight: within twice its
 /// radius of its centre.
@@ -48,11 +57,31 @@ pub(crate) const AIMED_DEPTH: u32 = 2;
 /// bounded in a scene with many specular objects.
 pub(crate) const MAX_CASTERS: usize = 8;
 
-/// A caster's bounding sphere in world space.
+/// A caster's bounding sphere in world space, and what weighs it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Caster {
     center: Vec3,
     radius: f32,
+    /// The instance it bounds.
+    instance: u32,
+    /// Its material's focus: 1 for glass, [`HALF_FOCUS`] for a mirror.
+    focus: f32,
+    /// The focus its weight takes: `focus`, or [`HALF_FOCUS`] for a glass ball that is
+    /// solved through ([`Casters::mark_solved`]).
+    weight_focus: f32,
+}
+
+impl Caster {
+    /// A caster of focus 1 (glass, not solved through) for instance 0.
+    fn sphere(center: Vec3, radius: f32) -> Caster {
+        Caster {
+            center,
+            radius,
+            instance: 0,
+            focus: 1.0,
+            weight_focus: 1.0,
+        }
+    }
 }
 
 /// The cone a caster subtends from a point outside it.
@@ -91,7 +120,7 @@ struct Slot {
     d2: f32,
     /// The caster's radius squared.
     r2: f32,
-    /// `min(1, sin^2 / NEAR)`; zero for a caster the vertex does not aim at.
+    /// `focus min(1, sin^2 / NEAR)`; zero for a caster the vertex does not aim at.
     weight: f32,
 }
 
@@ -134,14 +163,26 @@ impl Casters {
     /// whole motion ([`AnimatedTransform::motion_bounds`]): a vertex cannot know where along
     /// it a later ray will meet the object, and any sphere keeps the estimate unbiased.
     pub(crate) fn new<'a>(
-        instances: impl IntoIterator<Item = (&'a Material, &'a Shape, &'a Placement)>,
+        instances: impl IntoIterator<Item = (u32, &'a Material, &'a Shape, &'a Placement)>,
     ) -> Casters {
         let mut list: Vec<Caster> = instances
             .into_iter()
-            .filter(|(m, _, _)| m.is_specular())
-            .filter_map(|(_, shape, placement)| match placement {
-                Placement::Static(t) => bounding_sphere(shape, t),
-                Placement::Moving(a) => swept_sphere(shape, a),
+            .filter(|(_, m, _, _)| m.is_specular())
+            .filter_map(|(instance, material, shape, placement)| {
+                let sphere = match placement {
+                    Placement::Static(t) => bounding_sphere(shape, t),
+                    Placement::Moving(a) => swept_sphere(shape, a),
+                }?;
+                let focus = match material {
+                    Material::Dielectric { .. } => 1.0,
+                    _ => HALF_FOCUS,
+                };
+                Some(Caster {
+                    instance,
+                    focus,
+                    weight_focus: focus,
+                    ..sphere
+                })
             })
             .collect();
         if list.len() > MAX_CASTERS {
@@ -149,6 +190,19 @@ impl Casters {
             list.truncate(MAX_CASTERS);
         }
         Casters { list }
+    }
+
+    /// Gives the casters for which `solved(instance)` holds (glass balls that the vertices
+    /// near them solve through for every light) [`HALF_FOCUS`], and the others their
+    /// material's focus.
+    pub(crate) fn mark_solved(&mut self, solved: impl Fn(u32) -> bool) {
+        for caster in &mut self.list {
+            caster.weight_focus = if solved(caster.instance) {
+                HALF_FOCUS
+            } else {
+                caster.focus
+            };
+        }
     }
 
     /// How many casters there are.
@@ -181,7 +235,7 @@ impl Casters {
             if !outside || to_center.dot(n) < -c.radius {
                 continue;
             }
-            let weight = (r2 / (NEAR * d2)).min(1.0);
+            let weight = (r2 / (NEAR * d2)).min(1.0) * c.weight_focus;
             *slot = Slot {
                 to_center,
                 d2,
@@ -294,7 +348,8 @@ fn box_sphere(b: Bounds3<World>, grow: f32) -> Option<Caster> {
 
 /// A caster, when its centre and radius are finite and the radius positive.
 fn finite(center: Vec3, radius: f32) -> Option<Caster> {
-    (center.is_finite() && radius.is_finite() && radius > 0.0).then_some(Caster { center, radius })
+    (center.is_finite() && radius.is_finite() && radius > 0.0)
+        .then(|| Caster::sphere(center, radius))
 }
 
 #[cfg(test)]
@@ -308,7 +363,7 @@ mod tests {
         Casters {
             list: list
                 .iter()
-                .map(|&(center, radius)| Caster { center, radius })
+                .map(|&(center, radius)| Caster::sphere(center, radius))
                 .collect(),
         }
     }
@@ -346,23 +401,19 @@ mod tests {
         let moving = slide(Mat4::IDENTITY, Mat4::from_translation(Vec3::X));
         let (s, fixed) = (ball(1.0), at(0.0, 2.0, 0.0));
         let c = Casters::new([
-            (&glass, &s, &fixed),
-            (&mirror, &s, &moving),
-            (&clay, &s, &fixed),
-            (&rough, &s, &fixed),
-            (&clay, &s, &moving),
+            (0, &glass, &s, &fixed),
+            (1, &mirror, &s, &moving),
+            (2, &clay, &s, &fixed),
+            (3, &rough, &s, &fixed),
+            (4, &clay, &s, &moving),
         ]);
         assert_eq!(c.len(), 2, "{:?}", c.list);
-        assert_eq!(
-            c.list[0],
-            Caster {
-                center: Vec3::new(0.0, 2.0, 0.0),
-                radius: 1.0
-            }
-        );
+        assert_eq!(c.list[0], Caster::sphere(Vec3::new(0.0, 2.0, 0.0), 1.0));
+        // The mirror keeps its instance and takes half a glass ball's focus.
+        assert_eq!((c.list[1].instance, c.list[1].focus), (1, HALF_FOCUS));
         // The unit ball slid by 1 along x: its centre sweeps (0, 0, 0) to (1, 0, 0), so the
         // sphere is centred at (0.5, 0, 0) with radius 0.5 + 1.
-        let swept = |placement: &Placement| Casters::new([(&glass, &s, placement)]).list[0];
+        let swept = |placement: &Placement| Casters::new([(0, &glass, &s, placement)]).list[0];
         let c = swept(&moving);
         assert!(
             (c.center - Vec3::new(0.5, 0.0, 0.0)).length() < 1e-6,
@@ -398,10 +449,7 @@ mod tests {
         };
         assert_eq!(
             bounding_sphere(&s, &m),
-            Some(Caster {
-                center: Vec3::new(3.0, 4.0, 6.0),
-                radius: 2.0
-            })
+            Some(Caster::sphere(Vec3::new(3.0, 4.0, 6.0), 2.0))
         );
         // Stretched by 2 along y it is an ellipsoid: the sphere through its box's corners,
         // [-1, 1] x [-2, 2] x [-1, 1], has radius sqrt(1 + 4 + 1).
@@ -444,7 +492,7 @@ mod tests {
         let glass = Material::Dielectric { ior: 1.5 };
         let shapes: Vec<Shape> = (0..MAX_CASTERS + 4).map(|k| ball(1.0 + k as f32)).collect();
         let fixed = at(0.0, 0.0, 0.0);
-        let c = Casters::new(shapes.iter().map(|s| (&glass, s, &fixed)));
+        let c = Casters::new(shapes.iter().map(|s| (0, &glass, s, &fixed)));
         assert_eq!(c.len(), MAX_CASTERS);
         assert!(c.list.iter().all(|c| c.radius >= 5.0), "{:?}", c.list);
     }
@@ -478,6 +526,44 @@ mod tests {
         // Half below the horizon (the axis in the tangent plane) still counts.
         let side = casters(&[(Vec3::new(4.0, 0.0, 0.0), 1.0)]);
         assert!(side.at(Vec3::ZERO, up).share() > 0.0);
+    }
+
+    #[test]
+    fn mirrors_and_solved_glass_take_half_a_share() {
+        let up = Vec3::Y;
+        let glass = Material::Dielectric { ior: 1.5 };
+        let mirror = Material::Mirror {
+            reflectance: Vec3::ONE,
+        };
+        let s = ball(1.0);
+        let (over, beside) = (at(0.0, 1.5, 0.0), at(1.5, 0.0, 0.0));
+        // Full weight from 1.5 away: a mirror alone takes half of SHARE.
+        let mut c = Casters::new([(7, &mirror, &s, &over)]);
+        assert_eq!(c.at(Vec3::ZERO, up).share(), SHARE * HALF_FOCUS);
+        // Glass and a mirror side by side: weights 1 and 1/2, so the share is SHARE and the
+        // glass is picked two times in three.
+        c = Casters::new([(3, &glass, &s, &over), (7, &mirror, &s, &beside)]);
+        let aim = c.at(Vec3::ZERO, up);
+        assert_eq!(aim.share(), SHARE);
+        assert_eq!(aim.sample(Vec2::new(0.66, 0.5)).map(|(_, k)| k), Some(0));
+        assert_eq!(aim.sample(Vec2::new(0.67, 0.5)).map(|(_, k)| k), Some(1));
+        // Marked as solved through, the glass drops to half as well: weights 1/2 and 1/2,
+        // the share still SHARE, split evenly; alone, half of SHARE.
+        c.mark_solved(|instance| instance == 3);
+        let alone = Casters {
+            list: vec![c.list[0]],
+        };
+        assert_eq!(alone.at(Vec3::ZERO, up).share(), SHARE * HALF_FOCUS);
+        let aim = c.at(Vec3::ZERO, up);
+        assert_eq!(aim.share(), SHARE);
+        assert_eq!(aim.sample(Vec2::new(0.49, 0.5)).map(|(_, k)| k), Some(0));
+        assert_eq!(aim.sample(Vec2::new(0.51, 0.5)).map(|(_, k)| k), Some(1));
+        // Marking again with nothing solved gives the glass back its focus; a mirror (never
+        // a lens) keeps its half whatever it is marked.
+        c.mark_solved(|_| false);
+        assert_eq!(c.at(Vec3::ZERO, up).share(), SHARE);
+        c.mark_solved(|instance| instance == 7);
+        assert_eq!(c.at(Vec3::ZERO, up).share(), SHARE);
     }
 
     #[test]

@@ -169,7 +169,8 @@ impl ShadingScene {
     /// among `instances` (`(instance, shape, placement)`, instances numbered as for
     /// [`ShadingScene::new`]): those whose material is all delta lobes (glass, mirrors), each
     /// by the cone its bounding sphere subtends (a moving one's sphere holds it over its whole
-    /// motion). Caustics, light focused by such an object onto a diffuse surface, are then
+    /// motion), a mirror with half a glass ball's weight, as a glass ball that
+    /// [`ShadingScene::solve_through_glass`] solves through for every light. Caustics, light focused by such an object onto a diffuse surface, are then
     /// found far more often; the estimate stays
     /// unbiased (the samples are weighted by the mixture's density). Instances with an unknown
     /// number are ignored. Without this call no sample is aimed.
@@ -177,12 +178,26 @@ impl ShadingScene {
         &mut self,
         instances: impl IntoIterator<Item = (u32, &'a Shape, &'a Placement)>,
     ) {
-        let casters = Casters::new(
-            instances
-                .into_iter()
-                .filter_map(|(i, shape, placement)| Some((self.material(i)?, shape, placement))),
-        );
+        let casters =
+            Casters::new(instances.into_iter().filter_map(|(i, shape, placement)| {
+                Some((i, self.material(i)?, shape, placement))
+            }));
         self.casters = casters;
+        self.mark_solved_casters();
+    }
+
+    /// Gives the casters that are glass balls solved through for every light (each light a
+    /// static quad) half a share ([`crate::guide`]): near them the solve finds the light they
+    /// focus. With any other light they keep their full share.
+    fn mark_solved_casters(&mut self) {
+        let every_light = self
+            .lights
+            .iter()
+            .all(|l| matches!(l, Light::Area(a) if a.is_fixed_quad()));
+        let solved = self.solves && every_light;
+        let lenses = &self.lenses;
+        self.casters
+            .mark_solved(|instance| solved && lenses.index_of(instance).is_some());
     }
 
     /// Makes the vertices near a static ball of smooth glass among `instances` (`(instance,
@@ -209,6 +224,7 @@ impl ShadingScene {
             .any(|l| matches!(l, Light::Area(a) if a.is_fixed_quad()));
         self.solves = lenses.len() > 0 && quad_light;
         self.lenses = lenses;
+        self.mark_solved_casters();
     }
 
     /// How many glass balls vertices solve light paths through
@@ -319,11 +335,12 @@ pub struct PathIntegrator {
 /// its estimator changes (1 before diffuse vertices aimed at casters, 2 once they did, 3 since
 /// Russian roulette sees an aimed sample's throughput without the aim's weight, 4 since moving
 /// glass and mirrors are aimed at too, 5 since vertices near glass balls solve for the light
-/// through them). Films made by
+/// through them, 6 since mirrors and solved glass balls take half a share of the aimed
+/// samples). Films made by
 /// a build with another estimator are unbiased but not this build's image, so the renderer's
 /// scene fingerprint includes this number, as it includes the samplers'
 /// `obscura_sample::SEQUENCE_VERSION`.
-pub const ESTIMATOR_VERSION: u32 = 5;
+pub const ESTIMATOR_VERSION: u32 = 6;
 
 /// Densities below this are treated as zero (the path ends instead of dividing by them).
 const MIN_PDF: f32 = 1e-12;
