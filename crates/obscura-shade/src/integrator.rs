@@ -1160,3 +1160,74 @@ fn blocked(geometry: &Scene, hit: &Hit, chain: &Chain, y: Vec3) -> bool {
     .with_range(0.0, 1.0 - SHADOW_EPSILON);
     geometry.occluded(&to_light)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::guide::{HALF_FOCUS, SHARE};
+    use obscura_space::Transform;
+
+    /// A glass ball at the origin, a mirror ball 20 below it, a 1 x 1 quad light 10 above,
+    /// and, with `point`, a point light too; the casters and the lenses made in either order.
+    fn two_balls(point: bool, solve_first: bool) -> ShadingScene {
+        let materials = vec![
+            Material::Diffuse {
+                reflectance: Vec3::splat(0.5),
+            },
+            Material::Dielectric { ior: 1.5 },
+            Material::Mirror {
+                reflectance: Vec3::ONE,
+            },
+        ];
+        let fixed = Placement::Static(Transform::IDENTITY);
+        let quad = Shape::Quad {
+            origin: Vec3::new(-0.5, 10.0, -0.5),
+            edge_u: Vec3::X,
+            edge_v: Vec3::Z,
+        };
+        let lights = if point {
+            vec![Light::Point {
+                position: Vec3::new(3.0, 5.0, 0.0),
+                intensity: Vec3::ONE,
+            }]
+        } else {
+            vec![]
+        };
+        let emitters = vec![(2, quad, fixed.clone(), Vec3::ONE)];
+        let mut scene = ShadingScene::new(materials, vec![1, 2, 0], lights, emitters).unwrap();
+        let ball = |y| Shape::Sphere {
+            center: Vec3::new(0.0, y, 0.0),
+            radius: 1.0,
+        };
+        let (glass, mirror) = (ball(0.0), ball(-20.0));
+        let instances = [(0, &glass, &fixed), (1, &mirror, &fixed)];
+        if solve_first {
+            scene.solve_through_glass(instances);
+            scene.aim_at_specular(instances);
+        } else {
+            scene.aim_at_specular(instances);
+            scene.solve_through_glass(instances);
+        }
+        scene
+    }
+
+    #[test]
+    fn mirrors_and_glass_solved_for_every_light_take_half_a_share() {
+        // 1.5 below the glass, facing it (the mirror below the horizon), and 1.5 above the
+        // mirror, facing it (the glass below the horizon): each ball alone at full weight.
+        let at_glass = |s: &ShadingScene| s.casters.at(Vec3::new(0.0, -1.5, 0.0), Vec3::Y).share();
+        let at_mirror =
+            |s: &ShadingScene| s.casters.at(Vec3::new(0.0, -18.5, 0.0), -Vec3::Y).share();
+        for solve_first in [false, true] {
+            let quad_only = two_balls(false, solve_first);
+            assert_eq!(quad_only.lens_count(), 1);
+            assert_eq!(at_glass(&quad_only), SHARE * HALF_FOCUS);
+            assert_eq!(at_mirror(&quad_only), SHARE * HALF_FOCUS);
+            // The point light's caustic through the glass is not solved for: full share.
+            let with_point = two_balls(true, solve_first);
+            assert_eq!(with_point.lens_count(), 1);
+            assert_eq!(at_glass(&with_point), SHARE);
+            assert_eq!(at_mirror(&with_point), SHARE * HALF_FOCUS);
+        }
+    }
+}
