@@ -336,11 +336,12 @@ pub struct PathIntegrator {
 /// Russian roulette sees an aimed sample's throughput without the aim's weight, 4 since moving
 /// glass and mirrors are aimed at too, 5 since vertices near glass balls solve for the light
 /// through them, 6 since mirrors and solved glass balls take half a share of the aimed
-/// samples). Films made by
+/// samples, 7 since a BSDF sample through a ball is weighed against the solve only where the
+/// solve finds its chain). Films made by
 /// a build with another estimator are unbiased but not this build's image, so the renderer's
 /// scene fingerprint includes this number, as it includes the samplers'
 /// `obscura_sample::SEQUENCE_VERSION`.
-pub const ESTIMATOR_VERSION: u32 = 6;
+pub const ESTIMATOR_VERSION: u32 = 7;
 
 /// Densities below this are treated as zero (the path ends instead of dividing by them).
 const MIN_PDF: f32 = 1e-12;

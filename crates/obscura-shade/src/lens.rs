@@ -207,7 +207,9 @@ impl Lenses {
 
     /// For a path that left `x` along the unit direction `wi`, passed through ball `k` and
     /// reached `y`: the `(d_omega / dA_perp, transmittance)` that [`Lenses::chains`] gives
-    /// the chain it finds for it, for weighing the two ways of finding it against each other.
+    /// the chain it finds for it, for weighing the two ways of finding it against each other;
+    /// `None` when the solve would not find that chain (its scan misses the root), so that
+    /// the path's weight is then 1 and every path counts once.
     pub(crate) fn density_along(&self, k: usize, x: Vec3, wi: Vec3, y: Vec3) -> Option<(f32, f32)> {
         let (ball, plane, e1, e2) = self.plane(k, x, y)?;
         let wi = wi.as_dvec3();
@@ -217,6 +219,9 @@ impl Lenses {
             return None;
         }
         let b = (plane.d * wi.dot(e2)).clamp(-1.0, 1.0);
+        if !plane.finds(b) {
+            return None;
+        }
         let path = plane.path(b)?;
         Some((
             plane.density(b, ball.radius)?,
@@ -361,6 +366,21 @@ impl Plane {
         }
     }
 
+    /// Whether [`Plane::roots`] finds the root of `g` at `b`: whether the ends of the scan's
+    /// step around `b` differ in sign. A step with two roots (next to a fold) has ends of one
+    /// sign, and the scan finds neither. A step with three (next to the cusp of the lens's
+    /// caustic) counts as found, though the scan refines to one of them.
+    fn finds(&self, b: f64) -> bool {
+        let step = 2.0 / SCAN as f64;
+        // The same nodes as the scan's, `-1 + step i`, so the same signs.
+        let i = (((b + 1.0) / step).floor() as usize).min(SCAN - 1);
+        let (g0, g1) = (
+            self.miss(-1.0 + step * i as f64),
+            self.miss(-1.0 + step * (i + 1) as f64),
+        );
+        g0.is_finite() && g1.is_finite() && (g0 < 0.0) != (g1 < 0.0)
+    }
+
     /// The root of `g` between `a` and `b`, where it changes sign (the Illinois variant of
     /// the false position method, which converges superlinearly and stays bracketed).
     fn refine(&self, mut a: f64, mut ga: f64, mut b: f64, mut gb: f64) -> f64 {
@@ -462,6 +482,56 @@ mod tests {
                 let (per_area, t) = l.density_along(0, x, c.wi, y).unwrap();
                 prop_assert!((per_area / c.solid_angle_per_area - 1.0).abs() < 1e-2);
                 prop_assert!((t - c.transmittance).abs() < 1e-3);
+            }
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(2000))]
+        #[test]
+        fn the_paths_weighed_against_the_solve_are_the_chains_it_finds(
+            radius in 0.2f32..1.5,
+            ior in 1.05f32..2.5,
+            x_dir in prop::array::uniform3(-1.0f32..1.0),
+            x_far in 1.1f32..2.0,
+            across in prop::array::uniform3(-1.0f32..1.0),
+            s in -0.95f32..0.95,
+            beyond in 0.3f32..4.0,
+        ) {
+            // A path traced from x through the ball by Snell's law in 3D, to y on its exit
+            // ray. The path tracer weighs it against the solve (density_along is Some) if and
+            // only if the solve finds its chain: else a path would count less than once (the
+            // solve missing two roots next to a fold) or twice.
+            let center = Vec3::new(0.3, -0.2, 0.5);
+            let Some(x_dir) = Vec3::from(x_dir).try_normalize() else { return Ok(()) };
+            let x = center + x_dir * radius * x_far;
+            let axis = (center - x).normalize();
+            let v = Vec3::from(across);
+            let Some(perp) = (v - v.dot(axis) * axis).try_normalize() else { return Ok(()) };
+            let sin_alpha = s * radius / (center - x).length();
+            let wi = (1.0 - sin_alpha * sin_alpha).sqrt() * axis + sin_alpha * perp;
+            let to_c = center - x;
+            let t1 = wi.dot(to_c) - (radius * radius - (to_c.length_squared() - wi.dot(to_c).powi(2))).max(0.0).sqrt();
+            let p1 = x + t1 * wi;
+            let inside = refract(wi, (p1 - center) / radius, 1.0 / ior);
+            let p2 = p1 - 2.0 * (p1 - center).dot(inside) * inside;
+            let out = refract(inside, -(p2 - center) / radius, ior);
+            prop_assume!(out.is_finite());
+            let y = p2 + beyond * radius * out;
+            let l = lenses(center, radius, ior);
+            // Chains and the path compared by impact parameter in the solve's own plane, which
+            // f32's rounding of y turns a little when y is near the axis through x and the
+            // centre.
+            let Some((_, plane, _, e2)) = l.plane(0, x, y) else { return Ok(()) };
+            let b = |w: Vec3| plane.d * w.as_dvec3().dot(e2);
+            let near: Vec<Chain> = all_chains(&l, x, y)
+                .into_iter()
+                .filter(|c| (b(c.wi) - b(wi)).abs() < 1e-3)
+                .collect();
+            let weighed = l.density_along(0, x, wi, y).is_some();
+            prop_assert!(!weighed || !near.is_empty(), "weighed, but the solve finds no such chain");
+            if near.len() == 1 && near[0].transmittance > 0.0 {
+                prop_assert!(weighed, "the solve finds the chain {:?}, but it is not weighed", near[0]);
             }
         }
     }
