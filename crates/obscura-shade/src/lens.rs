@@ -40,10 +40,12 @@
 //! power heuristic, from the vertex's side and from the light's, so each path counts once.
 //! Near a fold of the chains (where the lens's own caustic meets the light) `d_omega / dA`
 //! grows without bound and the solve's weight goes to zero: the BSDF samples take those
-//! paths, and the solve has no fireflies. Roots closer together than a scan step lie next to
-//! such a fold and are missed together; the BSDF side still weighs such a path as if the solve
-//! had found it, so what the solve's small weight there would have added is lost: a small
-//! bias in a sliver along the lens's own caustic.
+//! paths, and the solve has no fireflies. Two roots within one scan step lie next to such a
+//! fold and are missed together, so the BSDF side weighs a path against the solve only where
+//! the scan's step around its root changes sign ([`Lenses::density_along`]); such paths are
+//! the BSDF samples' alone. Three roots in one step (at the cusp of the lens's caustic) still
+//! count as found, though the scan refines to one of them: what the solve would have added
+//! for the other two is lost there.
 
 use crate::light::solid_angle::{orientation_sign, world_sphere};
 use crate::material::{Material, fresnel_dielectric};
