@@ -170,10 +170,10 @@ impl ShadingScene {
     /// [`ShadingScene::new`]): those whose material is all delta lobes (glass, mirrors), each
     /// by the cone its bounding sphere subtends (a moving one's sphere holds it over its whole
     /// motion), a mirror with half a glass ball's weight, as a glass ball that
-    /// [`ShadingScene::solve_through_glass`] solves through for every light. Caustics, light focused by such an object onto a diffuse surface, are then
-    /// found far more often; the estimate stays
-    /// unbiased (the samples are weighted by the mixture's density). Instances with an unknown
-    /// number are ignored. Without this call no sample is aimed.
+    /// [`ShadingScene::solve_through_glass`] solves through for every light. Caustics, light
+    /// focused by such an object onto a diffuse surface, are then found far more often; the
+    /// estimate stays unbiased (the samples are weighted by the mixture's density). Instances
+    /// with an unknown number are ignored. Without this call no sample is aimed.
     pub fn aim_at_specular<'a>(
         &mut self,
         instances: impl IntoIterator<Item = (u32, &'a Shape, &'a Placement)>,
