@@ -8,7 +8,9 @@
 //! a mirroring light transform undoes.
 
 use crate::error::{ImportError, Location};
-use crate::scene::{CameraIr, FilmIr, GeometryIr, Imported, Ir, LightIr, MaterialIr, ShapeIr};
+use crate::scene::{
+    CameraIr, FilmIr, FilterIr, GeometryIr, Imported, Ir, LightIr, MaterialIr, ShapeIr,
+};
 use glam::{DMat4, DVec3, DVec4, Vec2, Vec3};
 use obscura_accel::TriangleMesh;
 use roxmltree::Node;
@@ -533,7 +535,8 @@ impl<'d, 'i> Mitsuba<'d, 'i> {
         let mut film = FilmIr {
             resolution: [768, 576],
             crop: None,
-            filter: Some(("gaussian", 1.5)),
+            // hdrfilm's default: a Gaussian of stddev 0.5.
+            filter: Some(mitsuba_gaussian(0.5)),
             loc: None,
         };
         if let Some(f) = n.children().find(|c| c.has_tag_name("film")) {
@@ -573,20 +576,36 @@ impl<'d, 'i> Mitsuba<'d, 'i> {
             if let Some(r) = f.children().find(|c| c.has_tag_name("rfilter")) {
                 let rloc = self.loc(r);
                 film.filter = Some(match self.need(r, "type")?.as_str() {
-                    "box" => ("box", 0.5),
-                    "tent" => ("triangle", self.float(r, "radius")?.unwrap_or(1.0) as f32),
-                    "mitchell" => ("mitchell", 2.0),
+                    "box" => FilterIr::new("box", 0.5),
+                    "tent" => {
+                        FilterIr::new("triangle", self.float(r, "radius")?.unwrap_or(1.0) as f32)
+                    }
+                    "mitchell" => FilterIr::new("mitchell", 2.0),
                     "gaussian" => {
-                        // Obscura's gaussian has sigma = radius / 3.
                         let s = self.float(r, "stddev")?.unwrap_or(0.5);
-                        ("gaussian", (3.0 * s).min(16.0) as f32)
+                        if !(s > 0.0 && s.is_finite()) {
+                            return Err(rloc.error(format!(
+                                "<rfilter type=\"gaussian\">: stddev must be > 0, got {s}"
+                            )));
+                        }
+                        if s > 4.0 {
+                            self.ir.warn(
+                                &rloc,
+                                format!(
+                                    "<rfilter type=\"gaussian\">: stddev {s} reaches {} \
+                                     pixels; cut at Obscura's widest radius, 16",
+                                    4.0 * s
+                                ),
+                            );
+                        }
+                        mitsuba_gaussian(s)
                     }
                     other => {
                         self.ir.warn(
                             &rloc,
                             format!("<rfilter type=\"{other}\">: not supported, using a gaussian"),
                         );
-                        ("gaussian", 1.5)
+                        mitsuba_gaussian(0.5)
                     }
                 });
             }
@@ -1126,4 +1145,15 @@ fn disk(n: u32) -> TriangleMesh {
     }
     let triangles = (0..n).map(|i| [0, 1 + i, 1 + (i + 1) % n]).collect();
     TriangleMesh::new(positions, triangles, None, None).expect("the disk is a valid mesh")
+}
+
+/// Mitsuba 3's `gaussian` of standard deviation `stddev`: `e^(-x^2 / 2 s^2) - e^(-8)`, cut at
+/// its radius of 4 s, which is Obscura's Gaussian of that radius and sigma (both capped at 16
+/// pixels, Obscura's widest filter).
+fn mitsuba_gaussian(stddev: f64) -> FilterIr {
+    FilterIr {
+        kind: "gaussian",
+        radius: (4.0 * stddev).min(16.0) as f32,
+        sigma: Some(stddev.min(16.0) as f32),
+    }
 }

@@ -15,8 +15,28 @@ use std::sync::Arc;
 pub(crate) struct FilmIr {
     pub(crate) resolution: [u32; 2],
     pub(crate) crop: Option<[f32; 4]>,
-    pub(crate) filter: Option<(&'static str, f32)>,
+    pub(crate) filter: Option<FilterIr>,
     pub(crate) loc: Option<Location>,
+}
+
+/// `[film] filter`: Obscura's filter name, its radius and, for a Gaussian whose standard
+/// deviation is not the default third of the radius, its `sigma`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct FilterIr {
+    pub(crate) kind: &'static str,
+    pub(crate) radius: f32,
+    pub(crate) sigma: Option<f32>,
+}
+
+impl FilterIr {
+    /// A filter of `kind` and `radius` with its default shape.
+    pub(crate) fn new(kind: &'static str, radius: f32) -> Self {
+        Self {
+            kind,
+            radius,
+            sigma: None,
+        }
+    }
 }
 
 /// `[camera]`: the model and its keys, the pose as world-from-camera matrices.
@@ -504,11 +524,15 @@ fn emit(ir: &Ir, mesh_dir: &str, base: &Path, source: &Path) -> Result<Emitted, 
         "resolution = [{}, {}]",
         film.resolution[0], film.resolution[1]
     );
-    if let Some((kind, radius)) = film.filter {
+    if let Some(f) = film.filter {
+        let sigma = f
+            .sigma
+            .map_or(String::new(), |s| format!(", sigma = {}", num(s)));
         let _ = writeln!(
             out,
-            "filter = {{ type = \"{kind}\", radius = {} }}",
-            num(radius)
+            "filter = {{ type = \"{}\", radius = {}{sigma} }}",
+            f.kind,
+            num(f.radius)
         );
     }
     if let Some(c) = film.crop {

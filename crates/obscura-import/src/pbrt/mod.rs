@@ -13,7 +13,8 @@ mod params;
 
 use crate::error::{ImportError, Location};
 use crate::scene::{
-    CameraIr, FilmIr, GeometryIr, Imported, Ir, LightIr, MaterialIr, RealisticIr, ShapeIr, StopIr,
+    CameraIr, FilmIr, FilterIr, GeometryIr, Imported, Ir, LightIr, MaterialIr, RealisticIr,
+    ShapeIr, StopIr,
 };
 use glam::{DMat4, DVec3, Vec2, Vec3};
 use lexer::{Kind, Token};
@@ -793,12 +794,6 @@ impl Pbrt {
                 ),
             );
         }
-        if kind == "gaussian" && p.num("sigma")?.is_some_and(|s| s != 0.5) {
-            self.ir.warn(
-                loc,
-                "PixelFilter: Obscura's gaussian has sigma = radius / 3",
-            );
-        }
         if kind == "mitchell"
             && (p.num("B")?.is_some_and(|b| b != 1.0 / 3.0)
                 || p.num("C")?.is_some_and(|c| c != 1.0 / 3.0))
@@ -818,7 +813,19 @@ impl Pbrt {
             filter: None,
             loc: None,
         });
-        film.filter = Some((ours, radius as f32));
+        let mut filter = FilterIr::new(ours, radius as f32);
+        if kind == "gaussian" {
+            // pbrt-v4's Gaussian: its radius and sigma (default 0.5) are Obscura's.
+            let sigma = p.num_or("sigma", 0.5)?;
+            if !(sigma > 0.0 && sigma <= 16.0 && sigma <= 20.0 * radius) {
+                return Err(loc.error(format!(
+                    "PixelFilter \"gaussian\": sigma must be in (0, 16] and at most 20 x \
+                     radius ({radius}), got {sigma}"
+                )));
+            }
+            filter.sigma = Some(sigma as f32);
+        }
+        film.filter = Some(filter);
         Ok(())
     }
 

@@ -49,6 +49,14 @@ fn sensor_defaults_are_mitsubas() {
     assert_eq!(d.film.resolution, [768, 576]);
     assert_eq!(d.sampler.kind.name(), "independent");
     assert_eq!(d.sampler.spp, 4);
+    // hdrfilm's default rfilter: a Gaussian of stddev 0.5, cut at 4 stddev.
+    assert_eq!(
+        d.film.filter,
+        obscura_render::FilterSettings::Gaussian {
+            radius: 2.0,
+            sigma: 0.5
+        }
+    );
 
     // fov_axis defaults to x; thinlens reads aperture_radius and focus_distance.
     let d = import(
@@ -63,6 +71,83 @@ fn sensor_defaults_are_mitsubas() {
         (d.camera.lens.radius, d.camera.lens.focal_distance),
         (0.2, 4.0)
     );
+}
+
+/// Each rfilter becomes Obscura's filter of the same profile: Mitsuba 3's `gaussian` is
+/// `e^(-x^2 / 2 stddev^2) - e^(-8)` cut at 4 stddev (its source, `rfilters/gaussian.cpp`),
+/// `tent` falls to 0 at its radius (default 1), and `box` covers its own pixel.
+#[test]
+fn rfilters_map_to_the_same_profile() {
+    use obscura_render::FilterSettings;
+    let scene = |rfilter: &str| {
+        format!(
+            "<scene version=\"3.0.0\">\n<sensor type=\"perspective\"><film type=\"hdrfilm\">\n\
+             {rfilter}\n</film></sensor></scene>"
+        )
+    };
+    for (rfilter, want) in [
+        (
+            "<rfilter type=\"gaussian\"/>",
+            FilterSettings::Gaussian {
+                radius: 2.0,
+                sigma: 0.5,
+            },
+        ),
+        (
+            "<rfilter type=\"gaussian\"><float name=\"stddev\" value=\"0.25\"/></rfilter>",
+            FilterSettings::Gaussian {
+                radius: 1.0,
+                sigma: 0.25,
+            },
+        ),
+        (
+            "<rfilter type=\"tent\"><float name=\"radius\" value=\"1.5\"/></rfilter>",
+            FilterSettings::Triangle { radius: 1.5 },
+        ),
+        (
+            "<rfilter type=\"tent\"/>",
+            FilterSettings::Triangle { radius: 1.0 },
+        ),
+        (
+            "<rfilter type=\"box\"/>",
+            FilterSettings::Box { radius: 0.5 },
+        ),
+    ] {
+        let imported = import(&scene(rfilter));
+        assert!(
+            imported.warnings.is_empty(),
+            "{rfilter}: {:?}",
+            imported.warnings
+        );
+        let d = imported.description().unwrap();
+        assert_eq!(d.film.filter, want, "{rfilter}");
+    }
+    // Wider than Obscura's widest filter: cut at 16 pixels, with a warning at its line.
+    let wide = import(&scene(
+        "<rfilter type=\"gaussian\"><float name=\"stddev\" value=\"5\"/></rfilter>",
+    ));
+    assert!(
+        wide.warnings.len() == 1 && wide.warnings[0].contains("test.xml:3"),
+        "{:?}",
+        wide.warnings
+    );
+    assert_eq!(
+        wide.description().unwrap().film.filter,
+        FilterSettings::Gaussian {
+            radius: 16.0,
+            sigma: 5.0
+        }
+    );
+    for stddev in ["0", "-0.5"] {
+        let e = import_err(&scene(&format!(
+            "<rfilter type=\"gaussian\"><float name=\"stddev\" value=\"{stddev}\"/></rfilter>"
+        )));
+        assert_eq!(line_of(&e), Some(3), "{stddev}: {e}");
+        assert!(
+            e.to_string().contains("stddev must be > 0"),
+            "{stddev}: {e}"
+        );
+    }
 }
 
 /// Where Mitsuba 3 puts world point `p`, by hand: its look-at frame (left = cross(up, dir)),

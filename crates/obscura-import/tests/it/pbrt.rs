@@ -50,10 +50,7 @@ fn camera_defaults_are_pbrts() {
     // volpath with maxdepth 5, zsobol (Obscura's sobol) at 16 spp, gaussian of radius 1.5.
     assert_eq!((d.integrator.max_depth, d.sampler.spp), (5, 16));
     assert_eq!(d.sampler.kind.name(), "sobol");
-    assert_eq!(
-        d.film.filter,
-        obscura_render::FilterSettings::Gaussian { radius: 1.5 }
-    );
+    assert_eq!(d.film.filter, obscura_render::FilterSettings::gaussian(1.5));
 
     let d = import(
         "Camera \"orthographic\" \"float lensradius\" 0.1 \"float focaldistance\" 3 \
@@ -93,6 +90,52 @@ fn film_sampler_filter_and_integrator_map() {
         obscura_render::FilterSettings::Triangle { radius: 2.0 }
     );
     assert_eq!(d.integrator.max_depth, 3);
+}
+
+/// pbrt-v4's Gaussian keeps its radius and its sigma (default 0.5); a sigma out of Obscura's
+/// range is an error at the directive's line.
+#[test]
+fn gaussian_filters_keep_their_sigma() {
+    use obscura_render::FilterSettings;
+    let scene = |filter: &str| format!("{filter}\nCamera \"perspective\"\nWorldBegin");
+    for (filter, want) in [
+        (
+            "PixelFilter \"gaussian\"",
+            FilterSettings::Gaussian {
+                radius: 1.5,
+                sigma: 0.5,
+            },
+        ),
+        (
+            "PixelFilter \"gaussian\" \"float sigma\" 0.75 \"float xradius\" 2 \"float yradius\" 2",
+            FilterSettings::Gaussian {
+                radius: 2.0,
+                sigma: 0.75,
+            },
+        ),
+    ] {
+        let imported = import(&scene(filter));
+        assert!(
+            imported.warnings.is_empty(),
+            "{filter}: {:?}",
+            imported.warnings
+        );
+        assert_eq!(
+            imported.description().unwrap().film.filter,
+            want,
+            "{filter}"
+        );
+    }
+    for sigma in ["0", "-1", "17", "40"] {
+        let e = import_err(&scene(&format!(
+            "\nPixelFilter \"gaussian\" \"float sigma\" {sigma}"
+        )));
+        assert_eq!(line_of(&e), Some(2), "{sigma}: {e}");
+        assert!(
+            e.to_string().contains("sigma must be in (0, 16]"),
+            "{sigma}: {e}"
+        );
+    }
 }
 
 /// Where pbrt-v4 puts world point `p` on a `w` x `h` film, computed by hand from its

@@ -18,7 +18,11 @@ impl Filter {
     /// A filter from validated settings.
     pub fn new(settings: FilterSettings) -> Self {
         let r = settings.radius();
-        let sigma = r / 3.0;
+        // Only the Gaussian reads these; the other filters keep a harmless sigma.
+        let sigma = match settings {
+            FilterSettings::Gaussian { sigma, .. } => sigma,
+            _ => r / 3.0,
+        };
         Self {
             settings,
             gaussian_floor: (-(r * r) / (2.0 * sigma * sigma)).exp(),
@@ -239,7 +243,7 @@ mod tests {
             let settings = [
                 FilterSettings::Box { radius },
                 FilterSettings::Triangle { radius },
-                FilterSettings::Gaussian { radius },
+                FilterSettings::gaussian(radius),
                 FilterSettings::Mitchell { radius },
             ][kind];
             let filter = Filter::new(settings);
@@ -249,13 +253,23 @@ mod tests {
             }
         }
 
-        /// The Gaussian is `e^(-d^2 / 2 sigma^2) - e^(-r^2 / 2 sigma^2)` with sigma = r / 3,
-        /// computed here in f64 from the definition.
+        /// The Gaussian is `e^(-d^2 / 2 sigma^2) - e^(-r^2 / 2 sigma^2)`, computed here in f64
+        /// from the definition, for the default sigma = r / 3 and for sigmas from r / 5 to 2 r
+        /// (Mitsuba 3's Gaussian is r = 4 sigma).
         #[test]
-        fn gaussian_matches_its_definition(d in -2.0f32..2.0, radius in 0.5f32..3.0) {
-            let filter = Filter::new(FilterSettings::Gaussian { radius });
+        fn gaussian_matches_its_definition(
+            d in -3.0f32..3.0,
+            radius in 0.5f32..3.0,
+            per_radius in proptest::option::of(0.2f32..2.0),
+        ) {
+            let settings = match per_radius {
+                None => FilterSettings::gaussian(radius),
+                Some(k) => FilterSettings::Gaussian { radius, sigma: k * radius },
+            };
+            let filter = Filter::new(settings);
             let (d64, r64) = (f64::from(d), f64::from(radius));
-            let two_var = 2.0 * (r64 / 3.0).powi(2);
+            let sigma = r64 * per_radius.map_or(1.0 / 3.0, f64::from);
+            let two_var = 2.0 * sigma * sigma;
             let want = if d64.abs() >= r64 {
                 0.0
             } else {
@@ -265,11 +279,28 @@ mod tests {
         }
     }
 
+    /// Mitsuba 3's default `gaussian` (stddev 0.5, radius 4 stddev = 2) worked by hand:
+    /// `e^(-2 d^2) - e^(-8)`, so 1 - 0.000335 at 0, e^-2 - e^-8 = 0.135000 at 1 and
+    /// e^-4.5 - e^-8 = 0.010774 at 1.5; pbrt-v4's default (radius 1.5, sigma 0.5) is
+    /// e^-2 - e^-4.5 = 0.124226 at 1.
+    #[test]
+    fn gaussians_of_mitsuba_and_pbrt_by_hand() {
+        let mitsuba = Filter::new(FilterSettings::Gaussian {
+            radius: 2.0,
+            sigma: 0.5,
+        });
+        for (d, want) in [(0.0, 0.999_665), (1.0, 0.135_000), (1.5, 0.010_774)] {
+            assert!((mitsuba.eval_1d(d) - want).abs() < 2e-6, "{d}");
+        }
+        let pbrt = Filter::new(FilterSettings::gaussian(1.5));
+        assert!((pbrt.eval_1d(1.0) - 0.124_226).abs() < 2e-6);
+    }
+
     #[test]
     fn filters_fall_to_zero_at_their_radius_and_peak_at_the_centre() {
         for settings in [
             FilterSettings::Triangle { radius: 1.0 },
-            FilterSettings::Gaussian { radius: 1.5 },
+            FilterSettings::gaussian(1.5),
             FilterSettings::Mitchell { radius: 2.0 },
         ] {
             let f = Filter::new(settings);

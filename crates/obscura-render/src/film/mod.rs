@@ -346,7 +346,7 @@ pub(crate) mod tests {
     /// A pass of random samples over a `w x h` film with a Gaussian filter (margins overlap
     /// neighbouring tiles, as in a render), tiles of 2x2 pixels.
     fn pass_film(w: u32, h: u32, samples: &[(f32, f32, f32, bool)]) -> Film {
-        let filter = Filter::new(FilterSettings::Gaussian { radius: 1.5 });
+        let filter = Filter::new(FilterSettings::gaussian(1.5));
         let mut film = Film::new(film_rect(w, h));
         for (k, &(x, y, l, hit)) in samples.iter().enumerate() {
             let (x, y) = (x * w as f32, y * h as f32);

@@ -155,7 +155,7 @@ mod tests {
 
     #[test]
     fn wide_filters_reach_neighbouring_tiles_through_the_margin() {
-        let filter = Filter::new(FilterSettings::Gaussian { radius: 1.5 });
+        let filter = Filter::new(FilterSettings::gaussian(1.5));
         let film_r = film_rect(8, 8);
         let mut tile = TileBuffer::new(
             PixelRect {
@@ -215,7 +215,7 @@ mod tests {
             let settings = match kind {
                 0 => FilterSettings::Box { radius },
                 1 => FilterSettings::Triangle { radius },
-                2 => FilterSettings::Gaussian { radius },
+                2 => FilterSettings::gaussian(radius),
                 _ => FilterSettings::Mitchell { radius },
             };
             let filter = Filter::new(settings);
@@ -257,7 +257,7 @@ mod tests {
         assert_eq!(margin(FilterSettings::Box { radius: 0.25 }), 0);
         assert_eq!(margin(FilterSettings::Box { radius: 1.5 }), 2);
         // The Gaussian of radius 1.5 is zero 1.5 from a centre: the second ring gets nothing.
-        assert_eq!(margin(FilterSettings::Gaussian { radius: 1.5 }), 1);
+        assert_eq!(margin(FilterSettings::gaussian(1.5)), 1);
         assert_eq!(margin(FilterSettings::Triangle { radius: 1.0 }), 1);
         assert_eq!(margin(FilterSettings::Mitchell { radius: 2.0 }), 2);
         assert_eq!(margin(FilterSettings::Triangle { radius: 5.3 }), 5);
@@ -268,7 +268,7 @@ mod tests {
     #[test]
     fn splat_weights_are_the_filter_product_narrow_and_wide() {
         for settings in [
-            FilterSettings::Gaussian { radius: 1.5 },
+            FilterSettings::gaussian(1.5),
             FilterSettings::Triangle { radius: 5.3 },
         ] {
             let filter = Filter::new(settings);

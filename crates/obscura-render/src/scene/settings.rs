@@ -99,10 +99,14 @@ pub enum FilterSettings {
         /// Radius in pixels.
         radius: f32,
     },
-    /// A Gaussian with standard deviation radius / 3, shifted to zero at the radius; default 1.5.
+    /// A Gaussian of standard deviation `sigma`, shifted down to zero at the radius:
+    /// `exp(-d^2 / 2 sigma^2) - exp(-r^2 / 2 sigma^2)` (pbrt-v4's and Mitsuba 3's form).
+    /// Defaults: radius 1.5, sigma radius / 3 ([`FilterSettings::gaussian`]).
     Gaussian {
         /// Radius in pixels.
         radius: f32,
+        /// Standard deviation in pixels.
+        sigma: f32,
     },
     /// Mitchell-Netravali with B = C = 1/3; default radius 2.
     Mitchell {
@@ -112,12 +116,21 @@ pub enum FilterSettings {
 }
 
 impl FilterSettings {
+    /// The Gaussian of a radius with its default standard deviation, a third of the radius
+    /// (pbrt-v4's default pair is radius 1.5, sigma 0.5).
+    pub fn gaussian(radius: f32) -> Self {
+        FilterSettings::Gaussian {
+            radius,
+            sigma: radius / 3.0,
+        }
+    }
+
     /// The filter's radius in pixels.
     pub fn radius(&self) -> f32 {
         match *self {
             FilterSettings::Box { radius }
             | FilterSettings::Triangle { radius }
-            | FilterSettings::Gaussian { radius }
+            | FilterSettings::Gaussian { radius, .. }
             | FilterSettings::Mitchell { radius } => radius,
         }
     }
