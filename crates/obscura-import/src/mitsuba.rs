@@ -580,7 +580,20 @@ impl<'d, 'i> Mitsuba<'d, 'i> {
                     "tent" => {
                         FilterIr::new("triangle", self.float(r, "radius")?.unwrap_or(1.0) as f32)
                     }
-                    "mitchell" => FilterIr::new("mitchell", 2.0),
+                    "mitchell" => {
+                        let b = self.float(r, "B")?.unwrap_or(1.0 / 3.0);
+                        let c = self.float(r, "C")?.unwrap_or(1.0 / 3.0);
+                        if (b - 1.0 / 3.0).abs() > 1e-6 || (c - 1.0 / 3.0).abs() > 1e-6 {
+                            self.ir.warn(
+                                &rloc,
+                                format!(
+                                    "<rfilter type=\"mitchell\">: B = {b}, C = {c}; \
+                                     Obscura's mitchell has B = C = 1/3"
+                                ),
+                            );
+                        }
+                        FilterIr::new("mitchell", 2.0)
+                    }
                     "gaussian" => {
                         let s = self.float(r, "stddev")?.unwrap_or(0.5);
                         if !(s > 0.0 && s.is_finite()) {

@@ -112,6 +112,10 @@ fn rfilters_map_to_the_same_profile() {
             "<rfilter type=\"box\"/>",
             FilterSettings::Box { radius: 0.5 },
         ),
+        (
+            "<rfilter type=\"mitchell\"><float name=\"B\" value=\"0.33333333\"/></rfilter>",
+            FilterSettings::Mitchell { radius: 2.0 },
+        ),
     ] {
         let imported = import(&scene(rfilter));
         assert!(
@@ -137,6 +141,15 @@ fn rfilters_map_to_the_same_profile() {
             radius: 16.0,
             sigma: 5.0
         }
+    );
+    // Another Mitchell-Netravali than B = C = 1/3: the same radius, with a warning.
+    let other = import(&scene(
+        "<rfilter type=\"mitchell\"><float name=\"B\" value=\"0\"/><float name=\"C\" value=\"0.5\"/></rfilter>",
+    ));
+    assert!(
+        other.warnings.len() == 1 && other.warnings[0].contains("B = 0, C = 0.5"),
+        "{:?}",
+        other.warnings
     );
     for stddev in ["0", "-0.5"] {
         let e = import_err(&scene(&format!(
