@@ -126,31 +126,35 @@ fn rfilters_map_to_the_same_profile() {
         let d = imported.description().unwrap();
         assert_eq!(d.film.filter, want, "{rfilter}");
     }
-    // Wider than Obscura's widest filter: cut at 16 pixels, with a warning at its line.
-    let wide = import(&scene(
-        "<rfilter type=\"gaussian\"><float name=\"stddev\" value=\"5\"/></rfilter>",
-    ));
-    assert!(
-        wide.warnings.len() == 1 && wide.warnings[0].contains("test.xml:3"),
-        "{:?}",
-        wide.warnings
-    );
-    assert_eq!(
-        wide.description().unwrap().film.filter,
-        FilterSettings::Gaussian {
-            radius: 16.0,
-            sigma: 5.0
-        }
-    );
-    // Another Mitchell-Netravali than B = C = 1/3: the same radius, with a warning.
-    let other = import(&scene(
-        "<rfilter type=\"mitchell\"><float name=\"B\" value=\"0\"/><float name=\"C\" value=\"0.5\"/></rfilter>",
-    ));
-    assert!(
-        other.warnings.len() == 1 && other.warnings[0].contains("B = 0, C = 0.5"),
-        "{:?}",
-        other.warnings
-    );
+    // Imported with a warning at the rfilter's line: a Gaussian wider than Obscura's widest
+    // filter, cut at 16 pixels, and a Mitchell-Netravali other than B = C = 1/3.
+    for (rfilter, warned, want) in [
+        (
+            "<rfilter type=\"gaussian\"><float name=\"stddev\" value=\"5\"/></rfilter>",
+            "cut at Obscura's widest radius",
+            FilterSettings::Gaussian {
+                radius: 16.0,
+                sigma: 5.0,
+            },
+        ),
+        (
+            "<rfilter type=\"mitchell\"><float name=\"B\" value=\"0\"/><float name=\"C\" value=\"0.5\"/></rfilter>",
+            "B = 0, C = 0.5",
+            FilterSettings::Mitchell { radius: 2.0 },
+        ),
+    ] {
+        let imported = import(&scene(rfilter));
+        let w = &imported.warnings;
+        assert!(
+            w.len() == 1 && w[0].contains("test.xml:3") && w[0].contains(warned),
+            "{rfilter}: {w:?}"
+        );
+        assert_eq!(
+            imported.description().unwrap().film.filter,
+            want,
+            "{rfilter}"
+        );
+    }
     for stddev in ["0", "-0.5"] {
         let e = import_err(&scene(&format!(
             "<rfilter type=\"gaussian\"><float name=\"stddev\" value=\"{stddev}\"/></rfilter>"
