@@ -19,8 +19,8 @@ pub(crate) struct FilmIr {
     pub(crate) loc: Option<Location>,
 }
 
-/// `[film] filter`: Obscura's filter name, its radius and, for a Gaussian whose standard
-/// deviation is not the default third of the radius, its `sigma`.
+/// `[film] filter`: Obscura's filter name, its radius and, for a Gaussian, the standard
+/// deviation the source gave (`None`: Obscura's default, a third of the radius).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct FilterIr {
     pub(crate) kind: &'static str,
