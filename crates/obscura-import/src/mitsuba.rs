@@ -13,6 +13,7 @@ use crate::scene::{
 };
 use glam::{DMat4, DVec3, DVec4, Vec2, Vec3};
 use obscura_accel::TriangleMesh;
+use obscura_render::FilterSettings;
 use roxmltree::Node;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -601,12 +602,13 @@ impl<'d, 'i> Mitsuba<'d, 'i> {
                                 "<rfilter type=\"gaussian\">: stddev must be > 0, got {s}"
                             )));
                         }
-                        if s > 4.0 {
+                        let widest = FilterSettings::MAX_RADIUS;
+                        if 4.0 * s > f64::from(widest) {
                             self.ir.warn(
                                 &rloc,
                                 format!(
                                     "<rfilter type=\"gaussian\">: stddev {s} reaches {} \
-                                     pixels; cut at Obscura's widest radius, 16",
+                                     pixels; cut at Obscura's widest radius, {widest}",
                                     4.0 * s
                                 ),
                             );
@@ -1161,12 +1163,13 @@ fn disk(n: u32) -> TriangleMesh {
 }
 
 /// Mitsuba 3's `gaussian` of standard deviation `stddev`: `e^(-x^2 / 2 s^2) - e^(-8)`, cut at
-/// its radius of 4 s, which is Obscura's Gaussian of that radius and sigma (both capped at 16
-/// pixels, Obscura's widest filter).
+/// its radius of 4 s, which is Obscura's Gaussian of that radius and sigma (both capped at
+/// Obscura's widest filter).
 fn mitsuba_gaussian(stddev: f64) -> FilterIr {
+    let widest = f64::from(FilterSettings::MAX_RADIUS);
     FilterIr {
         kind: "gaussian",
-        radius: (4.0 * stddev).min(16.0) as f32,
-        sigma: Some(stddev.min(16.0) as f32),
+        radius: (4.0 * stddev).min(widest) as f32,
+        sigma: Some(stddev.min(widest) as f32),
     }
 }

@@ -19,6 +19,7 @@ use crate::scene::{
 use glam::{DMat4, DVec3, Vec2, Vec3};
 use lexer::{Kind, Token};
 use obscura_accel::TriangleMesh;
+use obscura_render::FilterSettings;
 use obscura_space::{AnimatedTransform, Object, Transform, World};
 use params::{Param, Params, Value};
 use std::collections::HashMap;
@@ -802,9 +803,10 @@ impl Pbrt {
                 .warn(loc, "PixelFilter: Obscura's mitchell has B = C = 1/3");
         }
         let radius = x.max(y);
-        if !(radius > 0.0 && radius <= 16.0) {
+        let widest = f64::from(FilterSettings::MAX_RADIUS);
+        if !(radius > 0.0 && radius <= widest) {
             return Err(loc.error(format!(
-                "PixelFilter: radius must be in (0, 16], got {radius}"
+                "PixelFilter: radius must be in (0, {widest}], got {radius}"
             )));
         }
         let film = self.ir.film.get_or_insert(FilmIr {
@@ -817,10 +819,12 @@ impl Pbrt {
         if kind == "gaussian" {
             // pbrt-v4's Gaussian: its radius and sigma (default 0.5) are Obscura's.
             let sigma = p.num_or("sigma", 0.5)?;
-            if !(sigma > 0.0 && sigma <= 16.0 && sigma <= 20.0 * radius) {
+            if !FilterSettings::sigma_fits(radius as f32, sigma as f32) {
                 return Err(loc.error(format!(
-                    "PixelFilter \"gaussian\": sigma must be in (0, 16] and at most 20 x \
-                     radius ({radius}), got {sigma}"
+                    "PixelFilter \"gaussian\": sigma must be in (0, {}] and at most {} x \
+                     radius ({radius}), got {sigma}",
+                    FilterSettings::MAX_RADIUS,
+                    FilterSettings::MAX_SIGMA_PER_RADIUS
                 )));
             }
             filter.sigma = Some(sigma as f32);

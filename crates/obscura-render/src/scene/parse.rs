@@ -310,7 +310,7 @@ impl Cx<'_> {
     fn filter(&self, name: &str, radius: Option<f32>) -> Result<FilterSettings, RenderError> {
         if let Some(r) = radius {
             self.positive("film.filter.radius", r)?;
-            if r > 16.0 {
+            if r > FilterSettings::MAX_RADIUS {
                 return Err(self.err(
                     "film.filter.radius",
                     format!("must be at most 16 pixels, got {r}"),
@@ -339,15 +339,18 @@ impl Cx<'_> {
         })
     }
 
-    /// The Gaussian of `radius` with an explicit standard deviation: at most 16 pixels and at
-    /// most 20 radii. Wider, every weight is a difference of two exponentials within 0.13% of
-    /// each other, and f32 keeps too few of its digits.
+    /// The Gaussian of `radius` with an explicit standard deviation
+    /// ([`FilterSettings::sigma_fits`]).
     fn gaussian_sigma(&self, radius: f32, sigma: f32) -> Result<FilterSettings, RenderError> {
         self.positive("film.filter.sigma", sigma)?;
-        if sigma > 16.0 || sigma > 20.0 * radius {
+        if !FilterSettings::sigma_fits(radius, sigma) {
             return Err(self.err(
                 "film.filter.sigma",
-                format!("must be at most 16 pixels and 20 x radius ({radius}), got {sigma}"),
+                format!(
+                    "must be at most {} pixels and {} x radius ({radius}), got {sigma}",
+                    FilterSettings::MAX_RADIUS,
+                    FilterSettings::MAX_SIGMA_PER_RADIUS
+                ),
             ));
         }
         Ok(FilterSettings::Gaussian { radius, sigma })

@@ -116,6 +116,19 @@ pub enum FilterSettings {
 }
 
 impl FilterSettings {
+    /// The widest filter radius, and the widest Gaussian sigma, in pixels.
+    pub const MAX_RADIUS: f32 = 16.0;
+
+    /// How many radii a Gaussian's sigma may be at most: wider, every weight is a difference
+    /// of two exponentials within 0.13% of each other, and f32 keeps too few of its digits.
+    pub const MAX_SIGMA_PER_RADIUS: f32 = 20.0;
+
+    /// Whether `sigma` is a standard deviation the Gaussian of `radius` takes: in
+    /// `(0, MAX_RADIUS]` and at most `MAX_SIGMA_PER_RADIUS` radii (false for NaN).
+    pub fn sigma_fits(radius: f32, sigma: f32) -> bool {
+        sigma > 0.0 && sigma <= Self::MAX_RADIUS && sigma <= Self::MAX_SIGMA_PER_RADIUS * radius
+    }
+
     /// The Gaussian of a radius with its default standard deviation, a third of the radius
     /// (pbrt-v4's default pair is radius 1.5, sigma 0.5).
     pub fn gaussian(radius: f32) -> Self {
