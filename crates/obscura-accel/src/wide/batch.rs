@@ -3,20 +3,19 @@
 //! A query on a large mesh waits on memory at nearly every node it visits, one dependent miss
 //! after another, and one query's out-of-order window is too short to overlap them. A batch
 //! keeps [`LANES`] rays in flight: each takes one step (a node's box test or a packet's
-//! triangle test), asks for the lines of the node or packet it will visit next
-//! ([`prefetch`]), and yields to the next ray, so by the time a ray's turn comes round again
-//! its lines have had the other rays' steps to arrive. A ray that finishes hands its lane to
+//! triangle test), asks for the lines of the node or packet it will visit next ([`ask`], a
+//! prefetch), and yields to the next ray, so by the time a ray's turn comes round again its
+//! lines have had the other rays' steps to arrive. A ray that finishes hands its lane to
 //! the next ray of the batch.
 //!
 //! Each ray takes exactly the steps of the one-ray query ([`Closest::step`], [`Any::step`],
 //! shared with it), so every answer equals what [`WideBvh::closest`] or [`WideBvh::any`]
 //! gives for that ray.
 
-use super::layout::{INDEX, LEAF, Node, PAIR, Packet};
+use super::layout::{Node, Packet};
 use super::stack::Stack;
-use super::traverse::{Any, Closest, Step};
+use super::traverse::{Any, Closest, Step, ask};
 use super::{WideBvh, WideHit};
-use crate::simd::prefetch;
 use glam::Vec3A;
 
 /// Rays in flight at once.
@@ -81,7 +80,7 @@ impl InTurns for Closest<false> {
         packets: &[Packet],
         stack: &mut Stack<Self::Entry>,
     ) -> Option<Self::Answer> {
-        (!self.step::<false>(nodes, packets, stack, &mut 0)).then(|| self.hit(packets))
+        (!self.step::<false>(nodes, packets, stack)).then(|| self.hit(packets))
     }
     fn at(&self) -> u32 {
         self.current
@@ -103,7 +102,7 @@ impl InTurns for Any<false> {
         packets: &[Packet],
         stack: &mut Stack<Self::Entry>,
     ) -> Option<Self::Answer> {
-        match self.step::<false>(nodes, packets, stack, &mut 0) {
+        match self.step::<false>(nodes, packets, stack) {
             Step::Next => None,
             Step::Hit => Some(true),
             Step::Done => Some(false),
@@ -198,16 +197,3 @@ impl WideBvh {
 
 /// A ray's query in flight: the query, the ray's slot, and its stack.
 type Flight<Q> = (Q, usize, Stack<<Q as InTurns>::Entry>);
-
-/// Asks for the lines of the node or leaf (one packet or two) `r` names.
-#[inline(always)]
-fn ask(nodes: &[Node], packets: &[Packet], r: u32) {
-    if r & LEAF == 0 {
-        if let Some(node) = nodes.get(r as usize) {
-            prefetch(node, size_of::<Node>() / 64 - 1);
-        }
-    } else if let Some(packet) = packets.get((r & INDEX) as usize) {
-        let count = 1 + usize::from(r & PAIR != 0);
-        prefetch(packet, count * size_of::<Packet>() / 64 - 1);
-    }
-}

@@ -17,8 +17,8 @@
 //! A traversal over a 1M-triangle mesh is bound by memory latency, one cache miss per node
 //! visited, so the wide nodes (half the depth of a four-wide tree) matter most; nodes and
 //! packets are aligned to cache lines so none straddles one line more than it must, and the
-//! children a ray will visit later are touched when stacked so their lines load in the
-//! meantime. Large arrays live on transparent huge pages ([`Pages`]), so the visits are not
+//! lines of the children a ray will visit later are prefetched when they are stacked, so they
+//! load in the meantime. Large arrays live on transparent huge pages ([`Pages`]), so the visits are not
 //! also TLB misses.
 //!
 //! A batch of rays on a large tree is traversed in turns (`batch.rs`): eight rays in flight,

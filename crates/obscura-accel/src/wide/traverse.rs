@@ -5,6 +5,7 @@ use super::ray::{Prepared, by_entry};
 use super::stack::Stack;
 use super::{WideBvh, WideHit};
 use crate::geom::TriangleHit;
+use crate::simd::prefetch;
 use glam::{Vec3, Vec3A, Vec4};
 use std::cell::Cell;
 
@@ -70,9 +71,7 @@ impl WideBvh {
     ) -> Option<WideHit> {
         let (nodes, packets) = (&*self.nodes, &*self.packets);
         let mut q = Closest::<SLACK>::new(self.root, o, d, t_min, t_max);
-        let mut warm = 0u32;
-        while q.step::<true>(nodes, packets, stack, &mut warm) {}
-        std::hint::black_box(warm);
+        while q.step::<true>(nodes, packets, stack) {}
         q.hit(packets)
     }
 
@@ -87,16 +86,13 @@ impl WideBvh {
     ) -> bool {
         let (nodes, packets) = (&*self.nodes, &*self.packets);
         let mut q = Any::<SLACK>::new(self.root, o, d, t_min, t_max);
-        let mut warm = 0u32;
-        let hit = loop {
-            match q.step::<true>(nodes, packets, stack, &mut warm) {
+        loop {
+            match q.step::<true>(nodes, packets, stack) {
                 Step::Next => {}
                 Step::Hit => break true,
                 Step::Done => break false,
             }
-        };
-        std::hint::black_box(warm);
-        hit
+        }
     }
 }
 
@@ -127,15 +123,15 @@ impl<const SLACK: bool> Closest<SLACK> {
     /// One step of front-to-back traversal: the box test of the node the query is at (of
     /// the children it enters, the nearest is visited next and the others are stacked with
     /// their entry distance, so a later hit can skip them) or the triangle test of the
-    /// packet; then where to go next. False when there is nowhere left to go. `TOUCH`: read
-    /// one word of each line of a stacked child, so its lines load in the meantime.
+    /// packet; then where to go next. False when there is nowhere left to go. `AHEAD`: ask
+    /// for the lines of each stacked child ([`ask`]), so they load in the meantime (a batch
+    /// asks for each ray's next visit instead).
     #[inline(always)]
-    pub(super) fn step<const TOUCH: bool>(
+    pub(super) fn step<const AHEAD: bool>(
         &mut self,
         nodes: &[Node],
         packets: &[Packet],
         stack: &mut Stack<(u32, f32)>,
-        warm: &mut u32,
     ) -> bool {
         let current = self.current;
         if current & LEAF == 0 {
@@ -157,8 +153,8 @@ impl<const SLACK: bool> Closest<SLACK> {
                     let (ta, tb) = (t_near[a], t_near[b]);
                     let (near, far, t_far) = if tb < ta { (b, a, ta) } else { (a, b, tb) };
                     let far_child = node.child[far];
-                    if TOUCH {
-                        *warm ^= touch(nodes, packets, far_child);
+                    if AHEAD {
+                        ask(nodes, packets, far_child);
                     }
                     stack.push((far_child, t_far));
                     self.current = node.child[near];
@@ -168,8 +164,8 @@ impl<const SLACK: bool> Closest<SLACK> {
                 let mut hits = [(0u32, 0f32); ARITY];
                 let n = by_entry(mask, &t_near, |lane| node.child[lane], &mut hits);
                 for &entry in hits[1..n].iter().rev() {
-                    if TOUCH {
-                        *warm ^= touch(nodes, packets, entry.0);
+                    if AHEAD {
+                        ask(nodes, packets, entry.0);
                     }
                     stack.push(entry);
                 }
@@ -255,14 +251,13 @@ impl<const SLACK: bool> Any<SLACK> {
     }
 
     /// One step: a node's entered children are stacked in lane order (any order will do),
-    /// or a packet's triangles tested; then where to go next. `TOUCH` as for [`Closest`].
+    /// or a packet's triangles tested; then where to go next. `AHEAD` as for [`Closest`].
     #[inline(always)]
-    pub(super) fn step<const TOUCH: bool>(
+    pub(super) fn step<const AHEAD: bool>(
         &mut self,
         nodes: &[Node],
         packets: &[Packet],
         stack: &mut Stack<u32>,
-        warm: &mut u32,
     ) -> Step {
         let current = self.current;
         if current & LEAF == 0 {
@@ -273,8 +268,8 @@ impl<const SLACK: bool> Any<SLACK> {
                 mask &= mask - 1;
                 while mask != 0 {
                     let child = node.child[mask.trailing_zeros() as usize & 7];
-                    if TOUCH {
-                        *warm ^= touch(nodes, packets, child);
+                    if AHEAD {
+                        ask(nodes, packets, child);
                     }
                     stack.push(child);
                     mask &= mask - 1;
@@ -322,19 +317,17 @@ fn hit_record(p: &Packet, lane: usize, tri: TriangleHit) -> WideHit {
     }
 }
 
-/// Reads one word of each cache line of a stacked child, so its lines are on their way
-/// while the nearer child is traversed (safe Rust has no prefetch instruction; loads that
-/// nothing waits on do the same).
+/// Asks for the lines of the node or leaf (one packet or two) `r` names: a prefetch, which
+/// never changes a result and, unlike a load, does not hold up the instructions behind it
+/// while the lines come.
 #[inline(always)]
-fn touch(nodes: &[Node], packets: &[Packet], r: u32) -> u32 {
+pub(super) fn ask(nodes: &[Node], packets: &[Packet], r: u32) {
     if r & LEAF == 0 {
-        nodes.get(r as usize).map_or(0, |n| {
-            let b = &n.bounds;
-            b[0][0].x.to_bits() ^ b[2][0].y.to_bits() ^ b[4][0].z.to_bits() ^ n.child[0]
-        })
-    } else {
-        packets.get((r & INDEX) as usize).map_or(0, |p| {
-            p.v0[0].x.to_bits() ^ p.e1[1].y.to_bits() ^ p.e2[2].z.to_bits()
-        })
+        if let Some(node) = nodes.get(r as usize) {
+            prefetch(node, size_of::<Node>() / 64 - 1);
+        }
+    } else if let Some(packet) = packets.get((r & INDEX) as usize) {
+        let count = 1 + usize::from(r & PAIR != 0);
+        prefetch(packet, count * size_of::<Packet>() / 64 - 1);
     }
 }
