@@ -14,12 +14,12 @@
 //!
 //! Why not obvhs's own traversal: its compressed wide BVH (CWBVH) unpacks eight quantised child
 //! boxes per node and tests leaf triangles one at a time (docs/performance.md has the profile).
-//! A traversal over a 1M-triangle mesh is bound by memory latency, one cache miss per node
-//! visited, so the wide nodes (half the depth of a four-wide tree) matter most; nodes and
-//! packets are aligned to cache lines so none straddles one line more than it must, and the
-//! lines of the children a ray will visit later are prefetched when they are stacked, so they
-//! load in the meantime. Large arrays live on transparent huge pages ([`Pages`]), so the visits are not
-//! also TLB misses.
+//! A traversal over a 1M-triangle mesh waits on memory at nearly every node it visits, one
+//! miss after another, so the wide nodes (half the depth of a four-wide tree) matter most;
+//! nodes and packets are aligned to cache lines so none straddles one line more than it must,
+//! and the lines of the children a ray will visit later are prefetched when they are stacked,
+//! so they load in the meantime. Large arrays live on transparent huge pages ([`Pages`]), so
+//! the visits are not also TLB misses.
 //!
 //! A batch of rays on a large tree is traversed in turns (`batch.rs`): eight rays in flight,
 //! each taking one step and asking for the lines of its next node before the next ray's step,
