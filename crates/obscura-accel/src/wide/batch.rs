@@ -80,7 +80,7 @@ impl InTurns for Closest<false> {
         packets: &[Packet],
         stack: &mut Stack<Self::Entry>,
     ) -> Option<Self::Answer> {
-        (!self.step::<false>(nodes, packets, stack)).then(|| self.hit(packets))
+        (!self.step::<false, false>(nodes, packets, stack)).then(|| self.hit(packets))
     }
     fn at(&self) -> u32 {
         self.current
@@ -102,7 +102,7 @@ impl InTurns for Any<false> {
         packets: &[Packet],
         stack: &mut Stack<Self::Entry>,
     ) -> Option<Self::Answer> {
-        match self.step::<false>(nodes, packets, stack) {
+        match self.step::<false, false>(nodes, packets, stack) {
             Step::Next => None,
             Step::Hit => Some(true),
             Step::Done => Some(false),

@@ -231,11 +231,16 @@ impl<'a> Collapse<'a> {
             for (lane, &kid) in kids.iter().enumerate() {
                 node.set_box(lane, &self.bvh2.nodes[kid as usize].aabb);
             }
-            // Children are numbered before any grandchild, so siblings sit side by side.
+            // Children are numbered before any grandchild, so siblings sit side by side: the
+            // node's leaf packets are one run of the packet array, its child nodes one run of
+            // the node array.
             let first_new = work.len();
+            let (first_packet, first_node) = (out.packets.len() as u32, out.nodes.len() as u32);
             for (lane, &kid) in kids.iter().enumerate() {
                 node.child[lane] = self.reference(kid, out, &mut work);
             }
+            node.leaves = [first_packet, out.packets.len() as u32 - first_packet];
+            node.nodes = [first_node, out.nodes.len() as u32 - first_node];
             // Visit the first child's subtree next (depth first, for locality).
             work[first_new..].reverse();
             out.nodes[wide as usize] = node;

@@ -17,8 +17,9 @@ pub(super) const ARITY: usize = 8;
 /// Triangles per leaf packet (the SIMD width).
 pub(super) const WIDTH: usize = 4;
 /// Eight children's boxes, one lane per child (children 0-3 in the first register, 4-7 in
-/// the second), and what each child is: 224 bytes, padded to the four cache lines it would
-/// take anyway, and aligned to start a line so it never takes five.
+/// the second), what each child is, and where its children's data sits: 240 bytes, padded to
+/// the four cache lines it would take anyway, and aligned to start a line so it never takes
+/// five.
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 #[repr(C, align(64))]
 pub(super) struct Node {
@@ -27,8 +28,13 @@ pub(super) struct Node {
     /// A node index, `LEAF | packet index` (with [`PAIR`] for a leaf of that packet and the
     /// next), or `EMPTY`.
     pub(super) child: [u32; ARITY],
+    /// The first packet of the node's leaf children and how many packets they hold (they
+    /// sit side by side), so a visit can ask for them before its box test has chosen.
+    pub(super) leaves: [u32; 2],
+    /// The first of the node's child nodes and how many there are (side by side as well).
+    pub(super) nodes: [u32; 2],
     /// Explicit padding to 256 bytes, so a node is plain bytes ([`Pages`] maps it).
-    pub(super) _pad: [u32; 8],
+    pub(super) _pad: [u32; 4],
 }
 
 impl Node {
@@ -43,7 +49,9 @@ impl Node {
             [Vec4::NEG_INFINITY; 2],
         ],
         child: [EMPTY; ARITY],
-        _pad: [0; 8],
+        leaves: [0; 2],
+        nodes: [0; 2],
+        _pad: [0; 4],
     };
 
     /// Puts `aabb` in lane `lane`.

@@ -44,7 +44,8 @@ fn soup(n: usize, seed: u32) -> Vec<[Vec3A; 3]> {
 
 /// Every input triangle sits in exactly one packet lane (no pre-splits), every node's lane
 /// box contains everything beneath it, a two-packet leaf's second packet holds a triangle,
-/// and the stack bound covers the real depth.
+/// the stack bound covers the real depth, and each node's `leaves` and `nodes` name exactly
+/// the packets of its leaf children and its child nodes.
 #[test]
 fn the_collapse_keeps_every_triangle_once_inside_its_boxes() {
     let soups = [1, 2, 4, 5, 8, 9, 17, 300].map(|n| soup(n, n as u32));
@@ -68,6 +69,26 @@ fn the_collapse_keeps_every_triangle_once_inside_its_boxes() {
             depth_max = depth_max.max(depth);
             if r & LEAF == 0 {
                 let node = &bvh.nodes[r as usize];
+                let (mut packets, mut nodes) = (Vec::new(), Vec::new());
+                for &c in node.child.iter().filter(|&&c| c != EMPTY) {
+                    if c & LEAF == 0 {
+                        nodes.push(c);
+                    } else {
+                        let first = c & INDEX;
+                        packets.extend(first..=first + u32::from(c & PAIR != 0));
+                    }
+                }
+                packets.sort_unstable();
+                nodes.sort_unstable();
+                let run = |[first, count]: [u32; 2]| (first..first + count).collect::<Vec<_>>();
+                if !packets.is_empty() {
+                    assert_eq!(packets, run(node.leaves), "n = {n}");
+                }
+                assert_eq!(node.leaves[1] as usize, packets.len());
+                if !nodes.is_empty() {
+                    assert_eq!(nodes, run(node.nodes), "n = {n}");
+                }
+                assert_eq!(node.nodes[1] as usize, nodes.len());
                 for lane in 0..ARITY {
                     if node.child[lane] == EMPTY {
                         continue;
@@ -249,6 +270,13 @@ fn check_ray(tris: &[[Vec3A; 3]], bvh: &WideBvh, o: Vec3A, dir: Vec3A, t_min: f3
         brute.is_some(),
         "ray {k}, t_min {t_min}"
     );
+    // Asking ahead for what lies below each node changes no answer, bit for bit.
+    let (below, any_below) = bvh.queries_asking_below(o, dir, t_min, f32::INFINITY);
+    let bits = |h: Option<super::WideHit>| {
+        h.map(|h| (h.ids, [h.tri.t, h.tri.b1, h.tri.b2].map(f32::to_bits)))
+    };
+    assert_eq!(bits(below), bits(got), "ray {k}, t_min {t_min}");
+    assert_eq!(any_below, brute.is_some(), "ray {k}, t_min {t_min}");
 }
 
 #[test]
