@@ -18,7 +18,9 @@
 //! miss after another, so the wide nodes (half the depth of a four-wide tree) matter most;
 //! nodes and packets are aligned to cache lines so none straddles one line more than it must,
 //! and the lines of the children a ray will visit later are prefetched when they are stacked,
-//! so they load in the meantime. Large arrays live on transparent huge pages ([`Pages`]), so
+//! so they load in the meantime. On a tree too large for the caches, a query also asks for a
+//! node's leaf packets and first child node as soon as it reaches the node, before its box
+//! test has chosen among them. Large arrays live on transparent huge pages ([`Pages`]), so
 //! the visits are not also TLB misses.
 //!
 //! A batch of rays on a large tree is traversed in turns (`batch.rs`): eight rays in flight,
