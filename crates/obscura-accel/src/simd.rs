@@ -4,7 +4,8 @@
 //! Safe Rust has no prefetch instruction (`core::hint::prefetch_read` is not stable). A batch
 //! query ([`WideBvh::closest_batch`](crate::wide)) asks for the lines of the node a ray will
 //! visit next and then works on other rays while they arrive, and a one-ray query asks for
-//! the lines of each child it stacks; a plain load in their place would hold up the
+//! the lines of each child it stacks and, on a large tree, for a node's leaf packets and
+//! first child as soon as it reaches the node; a plain load in their place would hold up the
 //! retirement of everything behind it until the line came. The path tracer asks ahead in the
 //! same way for the environment map's cells a round of paths will read. A prefetch is a hint:
 //! it never faults and never changes what a later load returns, so the portable path (no
