@@ -313,7 +313,10 @@ impl Cx<'_> {
             if r > FilterSettings::MAX_RADIUS {
                 return Err(self.err(
                     "film.filter.radius",
-                    format!("must be at most 16 pixels, got {r}"),
+                    format!(
+                        "must be at most {} pixels, got {r}",
+                        FilterSettings::MAX_RADIUS
+                    ),
                 ));
             }
         }
