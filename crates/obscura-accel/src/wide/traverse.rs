@@ -40,12 +40,7 @@ impl WideBvh {
     #[inline]
     pub(crate) fn closest(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> Option<WideHit> {
         with_stack(&CLOSEST_STACK, |stack| {
-            match (t_min >= 0.0, self.asks_below()) {
-                (true, false) => self.closest_with::<false, false>(stack, o, d, t_min, t_max),
-                (true, true) => self.closest_with::<false, true>(stack, o, d, t_min, t_max),
-                (false, false) => self.closest_with::<true, false>(stack, o, d, t_min, t_max),
-                (false, true) => self.closest_with::<true, true>(stack, o, d, t_min, t_max),
-            }
+            self.closest_in(stack, o, d, t_min, t_max, self.asks_below())
         })
     }
 
@@ -53,12 +48,7 @@ impl WideBvh {
     #[inline]
     pub(crate) fn any(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> bool {
         with_stack(&ANY_STACK, |stack| {
-            match (t_min >= 0.0, self.asks_below()) {
-                (true, false) => self.any_with::<false, false>(stack, o, d, t_min, t_max),
-                (true, true) => self.any_with::<false, true>(stack, o, d, t_min, t_max),
-                (false, false) => self.any_with::<true, false>(stack, o, d, t_min, t_max),
-                (false, true) => self.any_with::<true, true>(stack, o, d, t_min, t_max),
-            }
+            self.any_in(stack, o, d, t_min, t_max, self.asks_below())
         })
     }
 
@@ -73,20 +63,51 @@ impl WideBvh {
         t_max: f32,
     ) -> (Option<WideHit>, bool) {
         let closest = with_stack(&CLOSEST_STACK, |stack| {
-            if t_min >= 0.0 {
-                self.closest_with::<false, true>(stack, o, d, t_min, t_max)
-            } else {
-                self.closest_with::<true, true>(stack, o, d, t_min, t_max)
-            }
+            self.closest_in(stack, o, d, t_min, t_max, true)
         });
         let any = with_stack(&ANY_STACK, |stack| {
-            if t_min >= 0.0 {
-                self.any_with::<false, true>(stack, o, d, t_min, t_max)
-            } else {
-                self.any_with::<true, true>(stack, o, d, t_min, t_max)
-            }
+            self.any_in(stack, o, d, t_min, t_max, true)
         });
         (closest, any)
+    }
+
+    /// [`closest`](WideBvh::closest) on `stack`, its traversal chosen once: the box test the
+    /// sign of `t_min` needs ([`Prepared`]), and whether each visit asks below.
+    #[inline(always)]
+    fn closest_in(
+        &self,
+        stack: &mut Stack<(u32, f32)>,
+        o: Vec3A,
+        d: Vec3A,
+        t_min: f32,
+        t_max: f32,
+        below: bool,
+    ) -> Option<WideHit> {
+        match (t_min >= 0.0, below) {
+            (true, false) => self.closest_with::<false, false>(stack, o, d, t_min, t_max),
+            (true, true) => self.closest_with::<false, true>(stack, o, d, t_min, t_max),
+            (false, false) => self.closest_with::<true, false>(stack, o, d, t_min, t_max),
+            (false, true) => self.closest_with::<true, true>(stack, o, d, t_min, t_max),
+        }
+    }
+
+    /// [`any`](WideBvh::any) on `stack`, chosen as [`closest_in`](WideBvh::closest_in) is.
+    #[inline(always)]
+    fn any_in(
+        &self,
+        stack: &mut Stack<u32>,
+        o: Vec3A,
+        d: Vec3A,
+        t_min: f32,
+        t_max: f32,
+        below: bool,
+    ) -> bool {
+        match (t_min >= 0.0, below) {
+            (true, false) => self.any_with::<false, false>(stack, o, d, t_min, t_max),
+            (true, true) => self.any_with::<false, true>(stack, o, d, t_min, t_max),
+            (false, false) => self.any_with::<true, false>(stack, o, d, t_min, t_max),
+            (false, true) => self.any_with::<true, true>(stack, o, d, t_min, t_max),
+        }
     }
 
     /// Whether a one-ray query asks for a node's leaf packets and first child node at its
