@@ -71,24 +71,88 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "{{\"triangles\": {}, \"build_s\": {build_s:.6}",
         mesh.triangle_count()
     );
+    // Every measure's passes are spread over the whole measuring time, one pass of each in
+    // turn, rather than run back to back: this host's noise comes and goes over seconds
+    // (docs/performance.md, "The host's noise"), and a measure's best pass should not depend
+    // on which second it happened to run in.
+    type Pass<'a> = Box<dyn FnMut(&[Ray<World>]) -> usize + 'a>;
+    let measures = || -> Vec<(&str, Pass<'_>)> {
+        let scene = &scene;
+        vec![
+            (
+                "closest",
+                Box::new(|rs: &[Ray<World>]| {
+                    rs.iter().filter(|r| scene.intersect(r).is_some()).count()
+                }),
+            ),
+            (
+                "occluded",
+                Box::new(|rs: &[Ray<World>]| rs.iter().filter(|r| scene.occluded(r)).count()),
+            ),
+            (
+                "preliminary",
+                Box::new(|rs: &[Ray<World>]| {
+                    rs.iter()
+                        .filter(|r| scene.intersect_preliminary(r).is_some())
+                        .count()
+                }),
+            ),
+            (
+                "preliminary_batch",
+                Box::new(|rs: &[Ray<World>]| {
+                    rs.chunks(BATCH)
+                        .map(|c| {
+                            scene
+                                .intersect_preliminary_batch(c)
+                                .iter()
+                                .filter(|h| h.is_some())
+                                .count()
+                        })
+                        .sum()
+                }),
+            ),
+            (
+                "occluded_batch",
+                Box::new(|rs: &[Ray<World>]| {
+                    rs.chunks(BATCH)
+                        .map(|c| scene.occluded_batch(c).iter().filter(|&&o| o).count())
+                        .sum()
+                }),
+            ),
+        ]
+    };
+    /// A measure on one ray set, and its fastest pass so far.
+    struct Run<'a> {
+        label: String,
+        rays: &'a [Ray<World>],
+        pass: Pass<'a>,
+        best: f64,
+    }
+    let mut runs = Vec::new();
     for (name, rays) in &sets {
-        let closest = rate(rays, |r| scene.intersect(r).is_some());
-        let occluded = rate(rays, |r| scene.occluded(r));
-        let preliminary = rate(rays, |r| scene.intersect_preliminary(r).is_some());
-        let batch = rate_batch(rays, |rs| {
-            scene
-                .intersect_preliminary_batch(rs)
-                .iter()
-                .filter(|h| h.is_some())
-                .count()
-        });
-        let occluded_batch = rate_batch(rays, |rs| {
-            scene.occluded_batch(rs).iter().filter(|&&o| o).count()
-        });
+        for (key, pass) in measures() {
+            runs.push(Run {
+                label: format!("{name}_{key}"),
+                rays,
+                pass,
+                best: f64::INFINITY,
+            });
+        }
+    }
+    for _ in 0..PASSES {
+        for run in &mut runs {
+            let start = Instant::now();
+            black_box((run.pass)(run.rays));
+            run.best = run.best.min(start.elapsed().as_secs_f64());
+        }
+    }
+    for run in &runs {
+        let rate = run.rays.len() as f64 / run.best;
+        out += &format!(", \"{}_rps\": {rate:.1}", run.label);
+    }
+    for (name, rays) in &sets {
         let hits = rays.iter().filter(|r| scene.intersect(r).is_some()).count();
-        out += &format!(
-            ", \"{name}_closest_rps\": {closest:.1}, \"{name}_preliminary_rps\": {preliminary:.1}, \"{name}_preliminary_batch_rps\": {batch:.1}, \"{name}_occluded_rps\": {occluded:.1}, \"{name}_occluded_batch_rps\": {occluded_batch:.1}, \"{name}_hits\": {hits}"
-        );
+        out += &format!(", \"{name}_hits\": {hits}");
     }
     out += "}";
     println!("{out}");
@@ -106,29 +170,11 @@ fn scene_of(mesh: &Arc<TriangleMesh>) -> Scene {
     builder.build().expect("a generated mesh builds")
 }
 
-/// Rays per second, best of five passes over the set.
-fn rate(rays: &[Ray<World>], mut query: impl FnMut(&Ray<World>) -> bool) -> f64 {
-    let mut best = f64::INFINITY;
-    for _ in 0..5 {
-        let start = Instant::now();
-        let n = rays.iter().filter(|r| query(r)).count();
-        black_box(n);
-        best = best.min(start.elapsed().as_secs_f64());
-    }
-    rays.len() as f64 / best
-}
+/// Passes of each measure over its ray set; each measure keeps its fastest.
+const PASSES: usize = 5;
 
-/// Rays per second of a batch query, best of five passes over the set in batches of 4096.
-fn rate_batch(rays: &[Ray<World>], mut query: impl FnMut(&[Ray<World>]) -> usize) -> f64 {
-    let mut best = f64::INFINITY;
-    for _ in 0..5 {
-        let start = Instant::now();
-        let n: usize = rays.chunks(4096).map(&mut query).sum();
-        black_box(n);
-        best = best.min(start.elapsed().as_secs_f64());
-    }
-    rays.len() as f64 / best
-}
+/// Rays per batch query.
+const BATCH: usize = 4096;
 
 /// A pinhole grid from outside the bounding sphere, its field just covering the sphere.
 fn primary_rays(center: glam::Vec3, radius: f32) -> Vec<Ray<World>> {
