@@ -214,6 +214,23 @@ impl Scene {
                 .map(|r| r.and_then(|r| Some((r, self.found(&r)?))))
                 .collect();
         };
+        if let Top::One = self.tlas {
+            // The flattened triangles are the only item: every valid ray goes to their BVH,
+            // over its whole range, with no walk over items to pause and resume.
+            let plain: Vec<Option<PlainRay>> = plain.collect();
+            let batch: Vec<BatchRay> = plain.iter().flatten().map(BatchRay::from).collect();
+            let mut hits = vec![None; batch.len()];
+            flat.closest_batch(&batch, &mut hits);
+            let mut hits = hits.into_iter();
+            return plain
+                .into_iter()
+                .map(|r| {
+                    let r = r?;
+                    let hit = hits.next().flatten()?;
+                    Some((r, Found::Flat { hit }))
+                })
+                .collect();
+        }
         // Each ray's walk over the items it enters, as in `found`: nearest first under a few
         // boxes, the one item (the flattened triangles) with no top level. It runs up to the
         // flattened triangles and, after the batch, on from there.
