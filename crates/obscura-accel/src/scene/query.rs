@@ -146,7 +146,7 @@ impl Scene {
     /// on each, but on a large mesh several rays are traversed in turns so that their cache
     /// misses overlap (faster per ray where the BVH does not fit the cache).
     pub fn intersect_batch(&self, rays: &[Ray<World>]) -> Vec<Option<Hit>> {
-        let found = self.found_batch(rays);
+        let found = self.found_batch(rays, |r, found| (r, found));
         // A mesh hit's record reads the triangle's vertex indices, then its vertices' normals,
         // at random in arrays of megabytes: ask for the indices of every hit, then, once
         // they have come, for the normals, so that the records' misses overlap. A mesh
@@ -191,27 +191,28 @@ impl Scene {
         &self,
         rays: &[Ray<World>],
     ) -> Vec<Option<PreliminaryHit<'_>>> {
-        self.found_batch(rays)
-            .into_iter()
-            .map(|f| {
-                f.map(|(ray, found)| PreliminaryHit {
-                    scene: self,
-                    ray,
-                    found,
-                })
-            })
-            .collect()
+        self.found_batch(rays, |ray, found| PreliminaryHit {
+            scene: self,
+            ray,
+            found,
+        })
     }
 
     /// What [`found`](Scene::found) gives for each ray, with the ray as checked. Each ray
     /// visits the items exactly as `found` does; where that order reaches the flattened
     /// triangles, the ray waits, and the waiting rays go through their BVH together
-    /// ([`WideBvh::closest_batch`]) before each goes on with the items after it.
-    fn found_batch(&self, rays: &[Ray<World>]) -> Vec<Option<(PlainRay, Found)>> {
+    /// ([`WideBvh::closest_batch`]) before each goes on with the items after it. Each answer
+    /// is made into the caller's record by `make` where it is found, so that no array of
+    /// intermediate records is written and copied again.
+    fn found_batch<T>(
+        &self,
+        rays: &[Ray<World>],
+        make: impl Fn(PlainRay, Found) -> T,
+    ) -> Vec<Option<T>> {
         let plain = rays.iter().map(PlainRay::new);
         let Some(flat) = self.pausable_flat() else {
             return plain
-                .map(|r| r.and_then(|r| Some((r, self.found(&r)?))))
+                .map(|r| r.and_then(|r| Some(make(r, self.found(&r)?))))
                 .collect();
         };
         if let Top::One = self.tlas {
@@ -227,7 +228,7 @@ impl Scene {
                 .map(|r| {
                     let r = r?;
                     let hit = hits.next().flatten()?;
-                    Some((r, Found::Flat { hit }))
+                    Some(make(r, Found::Flat { hit }))
                 })
                 .collect();
         }
@@ -307,7 +308,7 @@ impl Scene {
         }
         walks
             .into_iter()
-            .map(|w| w.and_then(|w| Some((w.r, w.best?))))
+            .map(|w| w.and_then(|w| Some(make(w.r, w.best?))))
             .collect()
     }
 
