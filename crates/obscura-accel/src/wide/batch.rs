@@ -43,15 +43,6 @@ pub(super) trait InTurns: Sized {
     type Entry: Copy + Default;
     /// The query of a ray with `t_min >= 0` from the tree's root.
     fn new(root: u32, r: &BatchRay) -> Self;
-    /// The ray's query, or its answer at once from the one-ray query: a ray that may start
-    /// behind its origin has the other box test, so it takes the one-ray query.
-    fn start(bvh: &WideBvh, r: &BatchRay) -> Result<Self, Self::Answer> {
-        if r.t_min >= 0.0 {
-            Ok(Self::new(bvh.root, r))
-        } else {
-            Err(Self::one(bvh, r))
-        }
-    }
     /// The one-ray query's answer.
     fn one(bvh: &WideBvh, r: &BatchRay) -> Self::Answer;
     /// One step; the answer once the query has one.
@@ -146,26 +137,30 @@ impl WideBvh {
     }
 
     /// The batch loop, in turns whatever the tree's size: each ray's query starts
-    /// ([`InTurns::start`]), steps and asks for its next node's lines in turn with the others,
+    /// ([`InTurns::new`]), steps and asks for its next node's lines in turn with the others,
     /// and hands its lane to the next ray when it has its answer.
     #[inline(always)]
     pub(super) fn run<Q: InTurns>(&self, rays: &[BatchRay], out: &mut [Q::Answer]) {
         let (nodes, packets) = (&*self.nodes, &*self.packets);
         let mut flights: Vec<Flight<Q>> = Vec::with_capacity(LANES);
         let mut slots = 0..rays.len().min(out.len());
-        // The next ray that needs a traversal, answering the others on the way.
+        // The slot of the next ray that takes turns, answering the others on the way: a ray
+        // that may start behind its origin has the other box test, so it takes the one-ray
+        // query. Only the slot is handed back, so that the lane's query is made in place
+        // rather than made elsewhere and copied in (it is some 260 bytes).
         let mut next = |out: &mut [Q::Answer]| {
             for slot in slots.by_ref() {
-                match Q::start(self, &rays[slot]) {
-                    Ok(q) => return Some((q, slot)),
-                    Err(answer) => out[slot] = answer,
+                let r = &rays[slot];
+                if r.t_min >= 0.0 {
+                    return Some(slot);
                 }
+                out[slot] = Q::one(self, r);
             }
             None
         };
         while flights.len() < LANES {
             match next(out) {
-                Some((q, slot)) => flights.push((q, slot, Stack::new())),
+                Some(slot) => flights.push((Q::new(self.root, &rays[slot]), slot, Stack::new())),
                 None => break,
             }
         }
@@ -181,8 +176,9 @@ impl WideBvh {
                 out[*slot] = answer;
                 // The lane's next ray takes over its query and its (emptied) stack in place.
                 match next(out) {
-                    Some((fresh, fresh_slot)) => {
-                        (*q, *slot) = (fresh, fresh_slot);
+                    Some(fresh) => {
+                        *q = Q::new(self.root, &rays[fresh]);
+                        *slot = fresh;
                         stack.clear();
                         i += 1;
                     }
