@@ -147,7 +147,8 @@ impl WideBvh {
         // The slot of the next ray that takes turns, answering the others on the way: a ray
         // that may start behind its origin has the other box test, so it takes the one-ray
         // query. Only the slot is handed back, so that the lane's query is made in place
-        // rather than made elsewhere and copied in (it is some 260 bytes).
+        // rather than made elsewhere and copied in (it holds its prepared ray: hundreds of
+        // bytes).
         let mut next = |out: &mut [Q::Answer]| {
             for slot in slots.by_ref() {
                 let r = &rays[slot];
