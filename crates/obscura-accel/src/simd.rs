@@ -10,7 +10,137 @@
 //! same way for the environment map's cells a round of paths will read. A prefetch is a hint:
 //! it never faults and never changes what a later load returns, so the portable path (no
 //! instruction at all) gives the same results.
+//!
+//! On x86-64 CPUs with AVX2, the one-ray and batch queries of the wide BVH run compiled for
+//! AVX2 ([`Avx2::run`]), and test a node's eight boxes in one eight-lane register
+//! ([`Avx2::slabs8`]) where the portable path takes two four-lane halves. The CPU is asked at
+//! run time ([`Avx2::detect`]); without AVX2 the portable path runs. Both do the same
+//! operations in the same order on each lane, with no fused multiply-add, so they give the
+//! same bits (tests below and in `wide/tests.rs`).
 #![allow(unsafe_code)]
+
+use glam::Vec4;
+#[cfg(target_arch = "x86_64")]
+use std::arch::x86_64::{
+    __m128, __m256, _CMP_LE_OQ, _mm256_add_ps, _mm256_andnot_ps, _mm256_broadcast_ps,
+    _mm256_cmp_ps, _mm256_max_ps, _mm256_min_ps, _mm256_movemask_ps, _mm256_mul_ps, _mm256_set1_ps,
+    _mm256_sub_ps,
+};
+
+/// Proof that the CPU runs AVX2: made only by [`Avx2::detect`], so the code it unlocks never
+/// runs on a CPU without the instructions.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Avx2(());
+
+impl Avx2 {
+    /// `Some` when this CPU has AVX2 (std asks the CPU once and keeps the answer).
+    #[inline(always)]
+    pub(crate) fn detect() -> Option<Avx2> {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::is_x86_feature_detected!("avx2") {
+                return Some(Avx2(()));
+            }
+        }
+        None
+    }
+
+    /// Runs `f` compiled with AVX2 enabled: `f` and everything inlined into it may use the
+    /// eight-lane instructions, and [`slabs8`](Avx2::slabs8) inlines into it.
+    #[inline(always)]
+    pub(crate) fn run<R>(self, f: impl FnOnce() -> R) -> R {
+        #[cfg(target_arch = "x86_64")]
+        {
+            // SAFETY: `self` exists only if `detect` found AVX2 on this CPU, which is all a
+            // function compiled with `target_feature(enable = "avx2")` requires of its caller.
+            unsafe { run_avx2(f) }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            f()
+        }
+    }
+
+    /// The slab test of a node's eight boxes, `bounds` as the node stores them (min x, max x,
+    /// min y, max y, min z, max z; four lanes to a `Vec4`), for a ray with splatted origin
+    /// `o`, near-plane reciprocals `inv`, far-plane reciprocals `far` and near-plane choice
+    /// `near` (1 where the direction is negative). Returns each lane's entry distance and the
+    /// mask of the lanes entered within `[t_min, t_max]`; `SLACK` widens each far distance by
+    /// `t + |t| * slack` first. The portable test's steps exactly
+    /// (`wide::ray::Prepared::slabs`), one register for all eight lanes.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    pub(crate) fn slabs8<const SLACK: bool>(
+        self,
+        bounds: &[[Vec4; 2]; 6],
+        o: &[Vec4; 3],
+        inv: &[Vec4; 3],
+        far: &[Vec4; 3],
+        near: [usize; 3],
+        range: [f32; 2],
+        slack: f32,
+    ) -> ([f32; 8], u32) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            // SAFETY: as in `run`: `self` proves the CPU has AVX2.
+            unsafe { slabs8_avx2::<SLACK>(bounds, o, inv, far, near, range, slack) }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            let _ = (bounds, o, inv, far, near, range, slack);
+            unreachable!("Avx2 is never made off x86-64")
+        }
+    }
+}
+
+/// [`Avx2::run`]'s body, compiled for AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+fn run_avx2<R>(f: impl FnOnce() -> R) -> R {
+    f()
+}
+
+/// [`Avx2::slabs8`], compiled for AVX2 (its intrinsics are safe to call here; it reads memory
+/// only through references, by value).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+fn slabs8_avx2<const SLACK: bool>(
+    bounds: &[[Vec4; 2]; 6],
+    o: &[Vec4; 3],
+    inv: &[Vec4; 3],
+    far: &[Vec4; 3],
+    near: [usize; 3],
+    [t_min, t_max]: [f32; 2],
+    slack: f32,
+) -> ([f32; 8], u32) {
+    let plane = |i: usize| bytemuck::cast::<[Vec4; 2], __m256>(bounds[i]);
+    let splat = |v: &Vec4| _mm256_broadcast_ps(&__m128::from(*v));
+    let (nx, ny, nz) = (near[0] & 1, near[1] & 1, near[2] & 1);
+    let (ox, oy, oz) = (splat(&o[0]), splat(&o[1]), splat(&o[2]));
+    let tnx = _mm256_mul_ps(_mm256_sub_ps(plane(nx), ox), splat(&inv[0]));
+    let tfx = _mm256_mul_ps(_mm256_sub_ps(plane(nx ^ 1), ox), splat(&far[0]));
+    let tny = _mm256_mul_ps(_mm256_sub_ps(plane(2 + ny), oy), splat(&inv[1]));
+    let tfy = _mm256_mul_ps(_mm256_sub_ps(plane(2 + (ny ^ 1)), oy), splat(&far[1]));
+    let tnz = _mm256_mul_ps(_mm256_sub_ps(plane(4 + nz), oz), splat(&inv[2]));
+    let tfz = _mm256_mul_ps(_mm256_sub_ps(plane(4 + (nz ^ 1)), oz), splat(&far[2]));
+    let entry = _mm256_max_ps(
+        _mm256_max_ps(tnx, tny),
+        _mm256_max_ps(tnz, _mm256_set1_ps(t_min)),
+    );
+    let t = _mm256_min_ps(_mm256_min_ps(tfx, tfy), tfz);
+    let t = if SLACK {
+        // |t|: the sign bit cleared, as the portable `abs` does.
+        let abs = _mm256_andnot_ps(_mm256_set1_ps(-0.0), t);
+        _mm256_add_ps(t, _mm256_mul_ps(abs, _mm256_set1_ps(slack)))
+    } else {
+        t
+    };
+    let exit = _mm256_min_ps(_mm256_set1_ps(t_max), t);
+    let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(entry, exit)) as u32;
+    (bytemuck::cast::<__m256, [f32; 8]>(entry), mask)
+}
 
 /// Asks for the cache line holding `*item` and the `extra_lines` lines after it, into every
 /// cache level. Never changes a result; a no-op on targets without the instruction.
@@ -40,6 +170,45 @@ pub fn prefetch<T>(item: &T, extra_lines: usize) {
     )))]
     {
         let _ = (item, extra_lines);
+    }
+}
+
+/// Asks for the lines of `count` items side by side from `*item` (at most `MAX`), each
+/// `LINES` cache lines long, into every cache level: [`prefetch`] unrolled, with one branch
+/// per item where a loop over the lines would take one per line.
+#[inline(always)]
+pub(crate) fn prefetch_items<T, const LINES: usize, const MAX: usize>(item: &T, count: usize) {
+    for k in 0..MAX {
+        if k < count {
+            for line in 0..LINES {
+                prefetch_line(item, k * LINES + line);
+            }
+        }
+    }
+}
+
+/// The `line`th cache line from `*item`'s, asked for.
+#[inline(always)]
+fn prefetch_line<T>(item: &T, line: usize) {
+    #[cfg(any(
+        target_arch = "x86_64",
+        all(target_arch = "x86", target_feature = "sse")
+    ))]
+    {
+        #[cfg(target_arch = "x86")]
+        use std::arch::x86::{_MM_HINT_T0, _mm_prefetch};
+        #[cfg(target_arch = "x86_64")]
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        let base = std::ptr::from_ref(item).cast::<i8>();
+        // SAFETY: as in `prefetch`: SSE is there, and a prefetch dereferences nothing.
+        unsafe { _mm_prefetch::<_MM_HINT_T0>(base.wrapping_add(64 * line)) };
+    }
+    #[cfg(not(any(
+        target_arch = "x86_64",
+        all(target_arch = "x86", target_feature = "sse")
+    )))]
+    {
+        let _ = (item, line);
     }
 }
 

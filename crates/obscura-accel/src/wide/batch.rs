@@ -13,9 +13,11 @@
 //! gives for that ray.
 
 use super::layout::{Node, Packet};
+use super::ray::{Level, Portable};
 use super::stack::Stack;
 use super::traverse::{Any, Closest, Step, ask};
 use super::{WideBvh, WideHit};
+use crate::simd::Avx2;
 use glam::Vec3A;
 
 /// Rays in flight at once.
@@ -45,9 +47,10 @@ pub(super) trait InTurns: Sized {
     fn new(root: u32, r: &BatchRay) -> Self;
     /// The one-ray query's answer.
     fn one(bvh: &WideBvh, r: &BatchRay) -> Self::Answer;
-    /// One step; the answer once the query has one.
-    fn advance(
+    /// One step with the box test of `level`; the answer once the query has one.
+    fn advance<L: Level>(
         &mut self,
+        level: L,
         nodes: &[Node],
         packets: &[Packet],
         stack: &mut Stack<Self::Entry>,
@@ -65,13 +68,14 @@ impl InTurns for Closest<false> {
     fn one(bvh: &WideBvh, r: &BatchRay) -> Self::Answer {
         bvh.closest(r.o, r.d, r.t_min, r.t_max)
     }
-    fn advance(
+    fn advance<L: Level>(
         &mut self,
+        level: L,
         nodes: &[Node],
         packets: &[Packet],
         stack: &mut Stack<Self::Entry>,
     ) -> Option<Self::Answer> {
-        (!self.step::<false, false>(nodes, packets, stack)).then(|| self.hit(packets))
+        (!self.step::<false, false, L>(level, nodes, packets, stack)).then(|| self.hit(packets))
     }
     fn at(&self) -> u32 {
         self.current
@@ -87,13 +91,14 @@ impl InTurns for Any<false> {
     fn one(bvh: &WideBvh, r: &BatchRay) -> Self::Answer {
         bvh.any(r.o, r.d, r.t_min, r.t_max)
     }
-    fn advance(
+    fn advance<L: Level>(
         &mut self,
+        level: L,
         nodes: &[Node],
         packets: &[Packet],
         stack: &mut Stack<Self::Entry>,
     ) -> Option<Self::Answer> {
-        match self.step::<false, false>(nodes, packets, stack) {
+        match self.step::<false, false, L>(level, nodes, packets, stack) {
             Step::Next => None,
             Step::Hit => Some(true),
             Step::Done => Some(false),
@@ -117,10 +122,14 @@ impl WideBvh {
         self.batch::<Any<false>>(rays, out);
     }
 
-    /// In turns on a large tree, one ray after another on a small one.
+    /// In turns on a large tree (compiled for AVX2 when the CPU has it, as the one-ray
+    /// queries are), one ray after another on a small one.
     fn batch<Q: InTurns>(&self, rays: &[BatchRay], out: &mut [Q::Answer]) {
         if self.interleaves() {
-            self.run::<Q>(rays, out);
+            match Avx2::detect() {
+                Some(avx2) => avx2.run(|| self.run::<Q, _>(avx2, rays, out)),
+                None => self.run::<Q, _>(Portable, rays, out),
+            }
         } else {
             for (r, o) in rays.iter().zip(out) {
                 *o = Q::one(self, r);
@@ -136,11 +145,16 @@ impl WideBvh {
         self.heap_bytes() >= INTERLEAVE_MIN_BYTES
     }
 
-    /// The batch loop, in turns whatever the tree's size: each ray's query starts
-    /// ([`InTurns::new`]), steps and asks for its next node's lines in turn with the others,
-    /// and hands its lane to the next ray when it has its answer.
+    /// The batch loop, in turns whatever the tree's size, with the box test of `level`: each
+    /// ray's query starts ([`InTurns::new`]), steps and asks for its next node's lines in
+    /// turn with the others, and hands its lane to the next ray when it has its answer.
     #[inline(always)]
-    pub(super) fn run<Q: InTurns>(&self, rays: &[BatchRay], out: &mut [Q::Answer]) {
+    pub(super) fn run<Q: InTurns, L: Level>(
+        &self,
+        level: L,
+        rays: &[BatchRay],
+        out: &mut [Q::Answer],
+    ) {
         let (nodes, packets) = (&*self.nodes, &*self.packets);
         let mut flights: Vec<Flight<Q>> = Vec::with_capacity(LANES);
         let mut slots = 0..rays.len().min(out.len());
@@ -169,7 +183,7 @@ impl WideBvh {
             let mut i = 0;
             while i < flights.len() {
                 let (q, slot, stack) = &mut flights[i];
-                let Some(answer) = q.advance(nodes, packets, stack) else {
+                let Some(answer) = q.advance(level, nodes, packets, stack) else {
                     ask(nodes, packets, q.at());
                     i += 1;
                     continue;

@@ -3,6 +3,7 @@
 
 use super::layout::{ARITY, Node, Packet, WIDTH};
 use crate::geom::gamma;
+use crate::simd::Avx2;
 use glam::{BVec4A, Vec3A, Vec4};
 
 /// pbrt's `gamma(3)`: the relative error of a slab distance `(b - o) * (1 / d)`; the far
@@ -131,6 +132,58 @@ impl<const SLACK: bool> Prepared<SLACK> {
             & t.cmpge(Vec4::splat(t_min))
             & t.cmple(Vec4::splat(t_max));
         (ok.bitmask(), t, b1, b2)
+    }
+}
+
+/// How a query tests a node's eight boxes: the same steps on every lane, in two four-lane
+/// halves ([`Portable`]) or in one eight-lane register ([`Avx2`], when the CPU has it). A
+/// query is generic over it, so each is compiled once and chosen once per query or batch.
+pub(super) trait Level: Copy {
+    /// [`Prepared::slabs`] of all [`ARITY`] lanes.
+    fn slabs<const SLACK: bool>(
+        self,
+        ray: &Prepared<SLACK>,
+        node: &Node,
+        t_min: f32,
+        t_max: f32,
+    ) -> ([f32; ARITY], u32);
+}
+
+/// The box test on any CPU: two four-lane halves.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Portable;
+
+impl Level for Portable {
+    #[inline(always)]
+    fn slabs<const SLACK: bool>(
+        self,
+        ray: &Prepared<SLACK>,
+        node: &Node,
+        t_min: f32,
+        t_max: f32,
+    ) -> ([f32; ARITY], u32) {
+        ray.slabs::<ARITY>(node, t_min, t_max)
+    }
+}
+
+impl Level for Avx2 {
+    #[inline(always)]
+    fn slabs<const SLACK: bool>(
+        self,
+        ray: &Prepared<SLACK>,
+        node: &Node,
+        t_min: f32,
+        t_max: f32,
+    ) -> ([f32; ARITY], u32) {
+        self.slabs8::<SLACK>(
+            &node.bounds,
+            &ray.o,
+            &ray.inv,
+            &ray.inv_far,
+            ray.near,
+            [t_min, t_max],
+            SLAB_SLACK,
+        )
     }
 }
 

@@ -1,10 +1,11 @@
 //! The wide BVH against testing every triangle, and the slab test's rounding bounds.
 
 use super::layout::{ARITY, EMPTY, INDEX, LEAF, Node, PAIR, WIDTH};
-use super::ray::{FAR_SCALE, slabs};
+use super::ray::{FAR_SCALE, Level, Portable, Prepared, slabs};
 use super::{Binary, WideBvh};
 use crate::BuildQuality;
 use crate::geom::intersect_triangle;
+use crate::simd::Avx2;
 use glam::{Vec3, Vec3A};
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
@@ -270,13 +271,30 @@ fn check_ray(tris: &[[Vec3A; 3]], bvh: &WideBvh, o: Vec3A, dir: Vec3A, t_min: f3
         brute.is_some(),
         "ray {k}, t_min {t_min}"
     );
-    // Asking ahead for what lies below each node changes no answer, bit for bit.
-    let (below, any_below) = bvh.queries_asking_below(o, dir, t_min, f32::INFINITY);
     let bits = |h: Option<super::WideHit>| {
         h.map(|h| (h.ids, [h.tri.t, h.tri.b1, h.tri.b2].map(f32::to_bits)))
     };
+    // The portable box test answers as the one the CPU was given (AVX2 where it has it),
+    // bit for bit.
+    let portable = bvh.closest_on(Portable, o, dir, t_min, f32::INFINITY);
+    assert_eq!(bits(portable), bits(got), "ray {k}, t_min {t_min}");
+    let any_portable = bvh.any_on(Portable, o, dir, t_min, f32::INFINITY);
+    assert_eq!(any_portable, brute.is_some(), "ray {k}, t_min {t_min}");
+    // Asking ahead for what lies below each node changes no answer, bit for bit, with
+    // either box test.
+    let (below, any_below) = bvh.queries_asking_below(Portable, o, dir, t_min, f32::INFINITY);
     assert_eq!(bits(below), bits(got), "ray {k}, t_min {t_min}");
     assert_eq!(any_below, brute.is_some(), "ray {k}, t_min {t_min}");
+    if let Some(avx2) = Avx2::detect() {
+        let fast = avx2.run(|| bvh.closest_on(avx2, o, dir, t_min, f32::INFINITY));
+        assert_eq!(bits(fast), bits(portable), "ray {k}, t_min {t_min}");
+        let any_fast = avx2.run(|| bvh.any_on(avx2, o, dir, t_min, f32::INFINITY));
+        assert_eq!(any_fast, brute.is_some(), "ray {k}, t_min {t_min}");
+        let (below, any_below) =
+            avx2.run(|| bvh.queries_asking_below(avx2, o, dir, t_min, f32::INFINITY));
+        assert_eq!(bits(below), bits(portable), "ray {k}, t_min {t_min}");
+        assert_eq!(any_below, brute.is_some(), "ray {k}, t_min {t_min}");
+    }
 }
 
 #[test]
@@ -325,6 +343,20 @@ proptest::proptest! {
         for (lane, _) in empty.iter().enumerate().filter(|(_, e)| **e) {
             proptest::prop_assert_eq!(mask & (1 << lane), 0);
         }
+        // The eight-lane AVX2 test gives the two four-lane halves' bits in every lane,
+        // entered or not, with either far-distance rounding.
+        if let Some(avx2) = Avx2::detect() {
+            let (fast, portable) = if t_min >= 0.0 {
+                let ray = Prepared::<false>::new(o, d);
+                (avx2.slabs(&ray, &node, t_min, t_max), Portable.slabs(&ray, &node, t_min, t_max))
+            } else {
+                let ray = Prepared::<true>::new(o, d);
+                (avx2.slabs(&ray, &node, t_min, t_max), Portable.slabs(&ray, &node, t_min, t_max))
+            };
+            proptest::prop_assert_eq!(fast.1, portable.1);
+            proptest::prop_assert_eq!(fast.0.map(f32::to_bits), portable.0.map(f32::to_bits));
+            proptest::prop_assert_eq!(portable.1, mask);
+        }
     }
 
     /// The slab test never culls a box the ray enters: rays through points on the
@@ -363,6 +395,15 @@ proptest::proptest! {
                 }
                 let o = Vec3::from_array(target) - d * before;
                 let (_, mask) = slabs::<ARITY>(o.into(), d.into(), &node, t_min, t_max);
+                // The AVX2 test, where the CPU has it, enters what the portable one enters.
+                let fast = Avx2::detect().map(|avx2| {
+                    let (o, d) = (o.into(), d.into());
+                    if t_min >= 0.0 {
+                        avx2.slabs(&Prepared::<false>::new(o, d), &node, t_min, t_max).1
+                    } else {
+                        avx2.slabs(&Prepared::<true>::new(o, d), &node, t_min, t_max).1
+                    }
+                });
 
                 // The same interval in f64 from the same f32 numbers.
                 let (mut near, mut far) = (f64::from(t_min), f64::from(t_max));
@@ -375,6 +416,9 @@ proptest::proptest! {
                 }
                 if far - near > 1e-12 * far.abs().max(near.abs()).max(1.0) {
                     proptest::prop_assert_eq!(mask & 1, 1, "near {} far {}", near, far);
+                    if let Some(fast) = fast {
+                        proptest::prop_assert_eq!(fast & 1, 1, "AVX2: near {} far {}", near, far);
+                    }
                 }
             }
         }
@@ -422,8 +466,26 @@ fn interleaved_batches_answer_as_one_ray_queries() {
             let rays = &rays[..len];
             let mut closest = vec![None; len];
             let mut any = vec![false; len];
-            bvh.run::<super::traverse::Closest<false>>(rays, &mut closest);
-            bvh.run::<super::traverse::Any<false>>(rays, &mut any);
+            bvh.run::<super::traverse::Closest<false>, _>(Portable, rays, &mut closest);
+            bvh.run::<super::traverse::Any<false>, _>(Portable, rays, &mut any);
+            // The batch with the AVX2 box test answers as with the portable one.
+            if let Some(avx2) = Avx2::detect() {
+                let mut fast = vec![None; len];
+                let mut any_fast = vec![false; len];
+                avx2.run(|| {
+                    bvh.run::<super::traverse::Closest<false>, _>(avx2, rays, &mut fast);
+                    bvh.run::<super::traverse::Any<false>, _>(avx2, rays, &mut any_fast);
+                });
+                let key = |h: &Option<super::WideHit>| {
+                    h.map(|h| (h.ids, [h.tri.t, h.tri.b1, h.tri.b2].map(f32::to_bits)))
+                };
+                assert_eq!(
+                    fast.iter().map(key).collect::<Vec<_>>(),
+                    closest.iter().map(key).collect::<Vec<_>>(),
+                    "{n} triangles, {len} rays"
+                );
+                assert_eq!(any_fast, any, "{n} triangles, {len} rays");
+            }
             for (k, r) in rays.iter().enumerate() {
                 let one = bvh.closest(r.o, r.d, r.t_min, r.t_max);
                 let key = |h: &super::WideHit| {

@@ -1,11 +1,11 @@
 //! The queries: front-to-back closest hit and any hit, each over a per-thread stack.
 
 use super::layout::{ARITY, EMPTY, INDEX, LEAF, Node, PAIR, Packet};
-use super::ray::{Prepared, by_entry};
+use super::ray::{Level, Portable, Prepared, by_entry};
 use super::stack::Stack;
 use super::{WideBvh, WideHit};
 use crate::geom::TriangleHit;
-use crate::simd::prefetch;
+use crate::simd::{Avx2, prefetch, prefetch_items};
 use glam::{Vec3, Vec3A, Vec4};
 use std::cell::Cell;
 
@@ -36,46 +36,83 @@ fn with_stack<T: Copy + Default, R>(
 }
 
 impl WideBvh {
-    /// The closest triangle hit with `t` in `[t_min, t_max]`.
+    /// The closest triangle hit with `t` in `[t_min, t_max]`, compiled for AVX2 when the CPU
+    /// has it ([`Avx2`]).
     #[inline]
     pub(crate) fn closest(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> Option<WideHit> {
-        with_stack(&CLOSEST_STACK, |stack| {
-            self.closest_in(stack, o, d, t_min, t_max, self.asks_below())
-        })
+        match Avx2::detect() {
+            Some(avx2) => avx2.run(|| self.closest_on(avx2, o, d, t_min, t_max)),
+            None => self.closest_on(Portable, o, d, t_min, t_max),
+        }
     }
 
     /// True when any triangle is hit with `t` in `[t_min, t_max]`; stops at the first found.
+    /// Compiled for AVX2 when the CPU has it, as [`closest`](WideBvh::closest) is.
     #[inline]
     pub(crate) fn any(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> bool {
+        match Avx2::detect() {
+            Some(avx2) => avx2.run(|| self.any_on(avx2, o, d, t_min, t_max)),
+            None => self.any_on(Portable, o, d, t_min, t_max),
+        }
+    }
+
+    /// [`closest`](WideBvh::closest) with the box test of `level`.
+    #[inline(always)]
+    pub(super) fn closest_on<L: Level>(
+        &self,
+        level: L,
+        o: Vec3A,
+        d: Vec3A,
+        t_min: f32,
+        t_max: f32,
+    ) -> Option<WideHit> {
+        with_stack(&CLOSEST_STACK, |stack| {
+            self.closest_in(level, stack, o, d, t_min, t_max, self.asks_below())
+        })
+    }
+
+    /// [`any`](WideBvh::any) with the box test of `level`.
+    #[inline(always)]
+    pub(super) fn any_on<L: Level>(
+        &self,
+        level: L,
+        o: Vec3A,
+        d: Vec3A,
+        t_min: f32,
+        t_max: f32,
+    ) -> bool {
         with_stack(&ANY_STACK, |stack| {
-            self.any_in(stack, o, d, t_min, t_max, self.asks_below())
+            self.any_in(level, stack, o, d, t_min, t_max, self.asks_below())
         })
     }
 
     /// The closest hit and the any-hit answer with [`ask_below`] on whatever the tree's size,
     /// for tests: asking ahead must never change an answer.
     #[cfg(test)]
-    pub(super) fn queries_asking_below(
+    pub(super) fn queries_asking_below<L: Level>(
         &self,
+        level: L,
         o: Vec3A,
         d: Vec3A,
         t_min: f32,
         t_max: f32,
     ) -> (Option<WideHit>, bool) {
         let closest = with_stack(&CLOSEST_STACK, |stack| {
-            self.closest_in(stack, o, d, t_min, t_max, true)
+            self.closest_in(level, stack, o, d, t_min, t_max, true)
         });
         let any = with_stack(&ANY_STACK, |stack| {
-            self.any_in(stack, o, d, t_min, t_max, true)
+            self.any_in(level, stack, o, d, t_min, t_max, true)
         });
         (closest, any)
     }
 
     /// [`closest`](WideBvh::closest) on `stack`, its traversal chosen once: the box test the
     /// sign of `t_min` needs ([`Prepared`]), and whether each visit asks below.
+    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn closest_in(
+    fn closest_in<L: Level>(
         &self,
+        level: L,
         stack: &mut Stack<(u32, f32)>,
         o: Vec3A,
         d: Vec3A,
@@ -84,17 +121,19 @@ impl WideBvh {
         below: bool,
     ) -> Option<WideHit> {
         match (t_min >= 0.0, below) {
-            (true, false) => self.closest_with::<false, false>(stack, o, d, t_min, t_max),
-            (true, true) => self.closest_with::<false, true>(stack, o, d, t_min, t_max),
-            (false, false) => self.closest_with::<true, false>(stack, o, d, t_min, t_max),
-            (false, true) => self.closest_with::<true, true>(stack, o, d, t_min, t_max),
+            (true, false) => self.closest_with::<false, false, L>(level, stack, o, d, t_min, t_max),
+            (true, true) => self.closest_with::<false, true, L>(level, stack, o, d, t_min, t_max),
+            (false, false) => self.closest_with::<true, false, L>(level, stack, o, d, t_min, t_max),
+            (false, true) => self.closest_with::<true, true, L>(level, stack, o, d, t_min, t_max),
         }
     }
 
     /// [`any`](WideBvh::any) on `stack`, chosen as [`closest_in`](WideBvh::closest_in) is.
+    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn any_in(
+    fn any_in<L: Level>(
         &self,
+        level: L,
         stack: &mut Stack<u32>,
         o: Vec3A,
         d: Vec3A,
@@ -103,10 +142,10 @@ impl WideBvh {
         below: bool,
     ) -> bool {
         match (t_min >= 0.0, below) {
-            (true, false) => self.any_with::<false, false>(stack, o, d, t_min, t_max),
-            (true, true) => self.any_with::<false, true>(stack, o, d, t_min, t_max),
-            (false, false) => self.any_with::<true, false>(stack, o, d, t_min, t_max),
-            (false, true) => self.any_with::<true, true>(stack, o, d, t_min, t_max),
+            (true, false) => self.any_with::<false, false, L>(level, stack, o, d, t_min, t_max),
+            (true, true) => self.any_with::<false, true, L>(level, stack, o, d, t_min, t_max),
+            (false, false) => self.any_with::<true, false, L>(level, stack, o, d, t_min, t_max),
+            (false, true) => self.any_with::<true, true, L>(level, stack, o, d, t_min, t_max),
         }
     }
 
@@ -118,8 +157,9 @@ impl WideBvh {
     }
 
     #[inline(always)]
-    fn closest_with<const SLACK: bool, const BELOW: bool>(
+    fn closest_with<const SLACK: bool, const BELOW: bool, L: Level>(
         &self,
+        level: L,
         stack: &mut Stack<(u32, f32)>,
         o: Vec3A,
         d: Vec3A,
@@ -128,13 +168,14 @@ impl WideBvh {
     ) -> Option<WideHit> {
         let (nodes, packets) = (&*self.nodes, &*self.packets);
         let mut q = Closest::<SLACK>::new(self.root, o, d, t_min, t_max);
-        while q.step::<true, BELOW>(nodes, packets, stack) {}
+        while q.step::<true, BELOW, L>(level, nodes, packets, stack) {}
         q.hit(packets)
     }
 
     #[inline(always)]
-    fn any_with<const SLACK: bool, const BELOW: bool>(
+    fn any_with<const SLACK: bool, const BELOW: bool, L: Level>(
         &self,
+        level: L,
         stack: &mut Stack<u32>,
         o: Vec3A,
         d: Vec3A,
@@ -144,7 +185,7 @@ impl WideBvh {
         let (nodes, packets) = (&*self.nodes, &*self.packets);
         let mut q = Any::<SLACK>::new(self.root, o, d, t_min, t_max);
         loop {
-            match q.step::<true, BELOW>(nodes, packets, stack) {
+            match q.step::<true, BELOW, L>(level, nodes, packets, stack) {
                 Step::Next => {}
                 Step::Hit => break true,
                 Step::Done => break false,
@@ -185,8 +226,9 @@ impl<const SLACK: bool> Closest<SLACK> {
     /// asks for each ray's next visit instead). `BELOW`: ask for a node's leaf packets and
     /// first child node before its box test runs ([`ask_below`]).
     #[inline(always)]
-    pub(super) fn step<const AHEAD: bool, const BELOW: bool>(
+    pub(super) fn step<const AHEAD: bool, const BELOW: bool, L: Level>(
         &mut self,
+        level: L,
         nodes: &[Node],
         packets: &[Packet],
         stack: &mut Stack<(u32, f32)>,
@@ -197,7 +239,7 @@ impl<const SLACK: bool> Closest<SLACK> {
             if BELOW {
                 ask_below(nodes, packets, node);
             }
-            let (t_near, mask) = self.ray.slabs::<ARITY>(node, self.t_min, self.t_best);
+            let (t_near, mask) = level.slabs(&self.ray, node, self.t_min, self.t_best);
             if mask != 0 {
                 let rest = mask & (mask - 1);
                 if rest == 0 {
@@ -315,8 +357,9 @@ impl<const SLACK: bool> Any<SLACK> {
     /// or a packet's triangles tested; then where to go next. `AHEAD` and `BELOW` as for
     /// [`Closest`].
     #[inline(always)]
-    pub(super) fn step<const AHEAD: bool, const BELOW: bool>(
+    pub(super) fn step<const AHEAD: bool, const BELOW: bool, L: Level>(
         &mut self,
+        level: L,
         nodes: &[Node],
         packets: &[Packet],
         stack: &mut Stack<u32>,
@@ -327,7 +370,7 @@ impl<const SLACK: bool> Any<SLACK> {
             if BELOW {
                 ask_below(nodes, packets, node);
             }
-            let (_, mut mask) = self.ray.slabs::<ARITY>(node, self.t_min, self.t_max);
+            let (_, mut mask) = level.slabs(&self.ray, node, self.t_min, self.t_max);
             if mask != 0 {
                 self.current = node.child[mask.trailing_zeros() as usize & 7];
                 mask &= mask - 1;
@@ -400,8 +443,10 @@ fn ask_below(nodes: &[Node], packets: &[Packet], node: &Node) {
     if count != 0
         && let Some(packet) = packets.get(first as usize)
     {
-        let lines = count.min(BELOW_PACKETS) as usize * size_of::<Packet>() / 64;
-        prefetch(packet, lines - 1);
+        prefetch_items::<_, { size_of::<Packet>() / 64 }, { BELOW_PACKETS as usize }>(
+            packet,
+            count as usize,
+        );
     }
     let [first, count] = node.nodes;
     if count != 0
