@@ -16,7 +16,7 @@
 //! ([`Avx2::slabs8`]) where the portable path takes two four-lane halves. The CPU is asked at
 //! run time ([`Avx2::detect`]); without AVX2 the portable path runs. Both do the same
 //! operations in the same order on each lane, with no fused multiply-add, so they give the
-//! same bits (tests below and in `wide/tests.rs`).
+//! same bits (`wide/tests.rs` compares them).
 #![allow(unsafe_code)]
 
 use glam::Vec4;
@@ -146,30 +146,8 @@ fn slabs8_avx2<const SLACK: bool>(
 /// cache level. Never changes a result; a no-op on targets without the instruction.
 #[inline(always)]
 pub fn prefetch<T>(item: &T, extra_lines: usize) {
-    #[cfg(any(
-        target_arch = "x86_64",
-        all(target_arch = "x86", target_feature = "sse")
-    ))]
-    {
-        #[cfg(target_arch = "x86")]
-        use std::arch::x86::{_MM_HINT_T0, _mm_prefetch};
-        #[cfg(target_arch = "x86_64")]
-        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-        let base = std::ptr::from_ref(item).cast::<i8>();
-        for line in 0..=extra_lines {
-            // SAFETY: `_mm_prefetch` needs SSE, which every x86-64 CPU has and the `x86` arm
-            // requires at compile time. It does not dereference its pointer (a prefetch of an
-            // unmapped address is dropped, never a fault); the address is computed with
-            // `wrapping_add`, so no out-of-bounds pointer arithmetic is asserted either.
-            unsafe { _mm_prefetch::<_MM_HINT_T0>(base.wrapping_add(64 * line)) };
-        }
-    }
-    #[cfg(not(any(
-        target_arch = "x86_64",
-        all(target_arch = "x86", target_feature = "sse")
-    )))]
-    {
-        let _ = (item, extra_lines);
+    for line in 0..=extra_lines {
+        prefetch_line(item, line);
     }
 }
 
@@ -187,7 +165,8 @@ pub(crate) fn prefetch_items<T, const LINES: usize, const MAX: usize>(item: &T, 
     }
 }
 
-/// The `line`th cache line from `*item`'s, asked for.
+/// Asks for the `line`th cache line from `*item`'s; a no-op on targets without the
+/// instruction.
 #[inline(always)]
 fn prefetch_line<T>(item: &T, line: usize) {
     #[cfg(any(
@@ -200,7 +179,10 @@ fn prefetch_line<T>(item: &T, line: usize) {
         #[cfg(target_arch = "x86_64")]
         use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
         let base = std::ptr::from_ref(item).cast::<i8>();
-        // SAFETY: as in `prefetch`: SSE is there, and a prefetch dereferences nothing.
+        // SAFETY: `_mm_prefetch` needs SSE, which every x86-64 CPU has and the `x86` arm
+        // requires at compile time. It does not dereference its pointer (a prefetch of an
+        // unmapped address is dropped, never a fault); the address is computed with
+        // `wrapping_add`, so no out-of-bounds pointer arithmetic is asserted either.
         unsafe { _mm_prefetch::<_MM_HINT_T0>(base.wrapping_add(64 * line)) };
     }
     #[cfg(not(any(

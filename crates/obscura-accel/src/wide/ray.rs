@@ -139,14 +139,31 @@ impl<const SLACK: bool> Prepared<SLACK> {
 /// halves ([`Portable`]) or in one eight-lane register ([`Avx2`], when the CPU has it). A
 /// query is generic over it, so each is compiled once and chosen once per query or batch.
 pub(super) trait Level: Copy {
-    /// [`Prepared::slabs`] of all [`ARITY`] lanes.
+    /// The AVX2 token, for the level that has one; a constant once the query is compiled.
+    fn avx2(self) -> Option<Avx2>;
+
+    /// [`Prepared::slabs`] of all [`ARITY`] lanes, with this level's instructions.
+    #[inline(always)]
     fn slabs<const SLACK: bool>(
         self,
         ray: &Prepared<SLACK>,
         node: &Node,
         t_min: f32,
         t_max: f32,
-    ) -> ([f32; ARITY], u32);
+    ) -> ([f32; ARITY], u32) {
+        match self.avx2() {
+            Some(avx2) => avx2.slabs8::<SLACK>(
+                &node.bounds,
+                &ray.o,
+                &ray.inv,
+                &ray.inv_far,
+                ray.near,
+                [t_min, t_max],
+                SLAB_SLACK,
+            ),
+            None => ray.slabs::<ARITY>(node, t_min, t_max),
+        }
+    }
 }
 
 /// The box test on any CPU: two four-lane halves.
@@ -155,35 +172,15 @@ pub(super) struct Portable;
 
 impl Level for Portable {
     #[inline(always)]
-    fn slabs<const SLACK: bool>(
-        self,
-        ray: &Prepared<SLACK>,
-        node: &Node,
-        t_min: f32,
-        t_max: f32,
-    ) -> ([f32; ARITY], u32) {
-        ray.slabs::<ARITY>(node, t_min, t_max)
+    fn avx2(self) -> Option<Avx2> {
+        None
     }
 }
 
 impl Level for Avx2 {
     #[inline(always)]
-    fn slabs<const SLACK: bool>(
-        self,
-        ray: &Prepared<SLACK>,
-        node: &Node,
-        t_min: f32,
-        t_max: f32,
-    ) -> ([f32; ARITY], u32) {
-        self.slabs8::<SLACK>(
-            &node.bounds,
-            &ray.o,
-            &ray.inv,
-            &ray.inv_far,
-            ray.near,
-            [t_min, t_max],
-            SLAB_SLACK,
-        )
+    fn avx2(self) -> Option<Avx2> {
+        Some(self)
     }
 }
 

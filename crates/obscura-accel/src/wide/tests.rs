@@ -271,30 +271,35 @@ fn check_ray(tris: &[[Vec3A; 3]], bvh: &WideBvh, o: Vec3A, dir: Vec3A, t_min: f3
         brute.is_some(),
         "ray {k}, t_min {t_min}"
     );
-    let bits = |h: Option<super::WideHit>| {
-        h.map(|h| (h.ids, [h.tri.t, h.tri.b1, h.tri.b2].map(f32::to_bits)))
-    };
-    // The portable box test answers as the one the CPU was given (AVX2 where it has it),
-    // bit for bit.
-    let portable = bvh.closest_on(Portable, o, dir, t_min, f32::INFINITY);
-    assert_eq!(bits(portable), bits(got), "ray {k}, t_min {t_min}");
-    let any_portable = bvh.any_on(Portable, o, dir, t_min, f32::INFINITY);
-    assert_eq!(any_portable, brute.is_some(), "ray {k}, t_min {t_min}");
-    // Asking ahead for what lies below each node changes no answer, bit for bit, with
-    // either box test.
-    let (below, any_below) = bvh.queries_asking_below(Portable, o, dir, t_min, f32::INFINITY);
-    assert_eq!(bits(below), bits(got), "ray {k}, t_min {t_min}");
-    assert_eq!(any_below, brute.is_some(), "ray {k}, t_min {t_min}");
-    if let Some(avx2) = Avx2::detect() {
-        let fast = avx2.run(|| bvh.closest_on(avx2, o, dir, t_min, f32::INFINITY));
-        assert_eq!(bits(fast), bits(portable), "ray {k}, t_min {t_min}");
-        let any_fast = avx2.run(|| bvh.any_on(avx2, o, dir, t_min, f32::INFINITY));
-        assert_eq!(any_fast, brute.is_some(), "ray {k}, t_min {t_min}");
-        let (below, any_below) =
-            avx2.run(|| bvh.queries_asking_below(avx2, o, dir, t_min, f32::INFINITY));
-        assert_eq!(bits(below), bits(portable), "ray {k}, t_min {t_min}");
-        assert_eq!(any_below, brute.is_some(), "ray {k}, t_min {t_min}");
+    // Both box tests, asking ahead for what lies below each node or not, give the same
+    // answers as the query the CPU was given (AVX2 where it has it), bit for bit.
+    let expected = (bits(got), brute.is_some());
+    for below in [false, true] {
+        let portable = (
+            bits(bvh.closest_in(Portable, o, dir, t_min, f32::INFINITY, below)),
+            bvh.any_in(Portable, o, dir, t_min, f32::INFINITY, below),
+        );
+        assert_eq!(portable, expected, "ray {k}, t_min {t_min}, below {below}");
+        if let Some(avx2) = Avx2::detect() {
+            let fast = avx2.run(|| {
+                (
+                    bits(bvh.closest_in(avx2, o, dir, t_min, f32::INFINITY, below)),
+                    bvh.any_in(avx2, o, dir, t_min, f32::INFINITY, below),
+                )
+            });
+            assert_eq!(
+                fast, expected,
+                "AVX2: ray {k}, t_min {t_min}, below {below}"
+            );
+        }
     }
+}
+
+/// A hit's ids and its distance and barycentrics' bits.
+type HitBits = Option<([u32; 2], [u32; 3])>;
+
+fn bits(h: Option<super::WideHit>) -> HitBits {
+    h.map(|h| (h.ids, [h.tri.t, h.tri.b1, h.tri.b2].map(f32::to_bits)))
 }
 
 #[test]
@@ -476,12 +481,9 @@ fn interleaved_batches_answer_as_one_ray_queries() {
                     bvh.run::<super::traverse::Closest<false>, _>(avx2, rays, &mut fast);
                     bvh.run::<super::traverse::Any<false>, _>(avx2, rays, &mut any_fast);
                 });
-                let key = |h: &Option<super::WideHit>| {
-                    h.map(|h| (h.ids, [h.tri.t, h.tri.b1, h.tri.b2].map(f32::to_bits)))
-                };
                 assert_eq!(
-                    fast.iter().map(key).collect::<Vec<_>>(),
-                    closest.iter().map(key).collect::<Vec<_>>(),
+                    fast.iter().copied().map(bits).collect::<Vec<_>>(),
+                    closest.iter().copied().map(bits).collect::<Vec<_>>(),
                     "{n} triangles, {len} rays"
                 );
                 assert_eq!(any_fast, any, "{n} triangles, {len} rays");

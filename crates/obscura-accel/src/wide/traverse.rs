@@ -40,9 +40,10 @@ impl WideBvh {
     /// has it ([`Avx2`]).
     #[inline]
     pub(crate) fn closest(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> Option<WideHit> {
+        let below = self.asks_below();
         match Avx2::detect() {
-            Some(avx2) => avx2.run(|| self.closest_on(avx2, o, d, t_min, t_max)),
-            None => self.closest_on(Portable, o, d, t_min, t_max),
+            Some(avx2) => avx2.run(|| self.closest_in(avx2, o, d, t_min, t_max, below)),
+            None => self.closest_in(Portable, o, d, t_min, t_max, below),
         }
     }
 
@@ -50,103 +51,53 @@ impl WideBvh {
     /// Compiled for AVX2 when the CPU has it, as [`closest`](WideBvh::closest) is.
     #[inline]
     pub(crate) fn any(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> bool {
+        let below = self.asks_below();
         match Avx2::detect() {
-            Some(avx2) => avx2.run(|| self.any_on(avx2, o, d, t_min, t_max)),
-            None => self.any_on(Portable, o, d, t_min, t_max),
+            Some(avx2) => avx2.run(|| self.any_in(avx2, o, d, t_min, t_max, below)),
+            None => self.any_in(Portable, o, d, t_min, t_max, below),
         }
     }
 
-    /// [`closest`](WideBvh::closest) with the box test of `level`.
+    /// [`closest`](WideBvh::closest) with the box test of `level` on this thread's stack, its
+    /// traversal chosen once: the box test the sign of `t_min` needs ([`Prepared`]), and
+    /// whether each visit asks below ([`ask_below`]; tests ask on trees of any size, since
+    /// asking ahead must never change an answer).
     #[inline(always)]
-    pub(super) fn closest_on<L: Level>(
+    pub(super) fn closest_in<L: Level>(
         &self,
         level: L,
-        o: Vec3A,
-        d: Vec3A,
-        t_min: f32,
-        t_max: f32,
-    ) -> Option<WideHit> {
-        with_stack(&CLOSEST_STACK, |stack| {
-            self.closest_in(level, stack, o, d, t_min, t_max, self.asks_below())
-        })
-    }
-
-    /// [`any`](WideBvh::any) with the box test of `level`.
-    #[inline(always)]
-    pub(super) fn any_on<L: Level>(
-        &self,
-        level: L,
-        o: Vec3A,
-        d: Vec3A,
-        t_min: f32,
-        t_max: f32,
-    ) -> bool {
-        with_stack(&ANY_STACK, |stack| {
-            self.any_in(level, stack, o, d, t_min, t_max, self.asks_below())
-        })
-    }
-
-    /// The closest hit and the any-hit answer with [`ask_below`] on whatever the tree's size,
-    /// for tests: asking ahead must never change an answer.
-    #[cfg(test)]
-    pub(super) fn queries_asking_below<L: Level>(
-        &self,
-        level: L,
-        o: Vec3A,
-        d: Vec3A,
-        t_min: f32,
-        t_max: f32,
-    ) -> (Option<WideHit>, bool) {
-        let closest = with_stack(&CLOSEST_STACK, |stack| {
-            self.closest_in(level, stack, o, d, t_min, t_max, true)
-        });
-        let any = with_stack(&ANY_STACK, |stack| {
-            self.any_in(level, stack, o, d, t_min, t_max, true)
-        });
-        (closest, any)
-    }
-
-    /// [`closest`](WideBvh::closest) on `stack`, its traversal chosen once: the box test the
-    /// sign of `t_min` needs ([`Prepared`]), and whether each visit asks below.
-    #[allow(clippy::too_many_arguments)]
-    #[inline(always)]
-    fn closest_in<L: Level>(
-        &self,
-        level: L,
-        stack: &mut Stack<(u32, f32)>,
         o: Vec3A,
         d: Vec3A,
         t_min: f32,
         t_max: f32,
         below: bool,
     ) -> Option<WideHit> {
-        match (t_min >= 0.0, below) {
+        with_stack(&CLOSEST_STACK, |stack| match (t_min >= 0.0, below) {
             (true, false) => self.closest_with::<false, false, L>(level, stack, o, d, t_min, t_max),
             (true, true) => self.closest_with::<false, true, L>(level, stack, o, d, t_min, t_max),
             (false, false) => self.closest_with::<true, false, L>(level, stack, o, d, t_min, t_max),
             (false, true) => self.closest_with::<true, true, L>(level, stack, o, d, t_min, t_max),
-        }
+        })
     }
 
-    /// [`any`](WideBvh::any) on `stack`, chosen as [`closest_in`](WideBvh::closest_in) is.
-    #[allow(clippy::too_many_arguments)]
+    /// [`any`](WideBvh::any) with the box test of `level`, chosen as
+    /// [`closest_in`](WideBvh::closest_in) is.
     #[inline(always)]
-    fn any_in<L: Level>(
+    pub(super) fn any_in<L: Level>(
         &self,
         level: L,
-        stack: &mut Stack<u32>,
         o: Vec3A,
         d: Vec3A,
         t_min: f32,
         t_max: f32,
         below: bool,
     ) -> bool {
-        match (t_min >= 0.0, below) {
+        with_stack(&ANY_STACK, |stack| match (t_min >= 0.0, below) {
             (true, false) => self.any_with::<false, false, L>(level, stack, o, d, t_min, t_max),
             (true, true) => self.any_with::<false, true, L>(level, stack, o, d, t_min, t_max),
             (false, false) => self.any_with::<true, false, L>(level, stack, o, d, t_min, t_max),
             (false, true) => self.any_with::<true, true, L>(level, stack, o, d, t_min, t_max),
-        }
+        })
     }
 
     /// Whether a one-ray query asks for a node's leaf packets and first child node at its
