@@ -2,7 +2,8 @@
 //! analytic spheres and quads, placed as static or moving instances, and a two-level BVH (built
 //! by binned surface area here, on rayon's threads, or by obvhs's PLOC for
 //! [`BuildQuality::Fast`]; laid out as 8-wide nodes with 4-triangle SIMD leaves and traversed
-//! here, compiled for AVX2 where the CPU has it) that answers closest-hit and any-hit (shadow) queries.
+//! here, compiled for AVX2 where the CPU has it) that answers closest-hit and any-hit (shadow)
+//! queries.
 //!
 //! This is the only Obscura crate that knows about BVHs. It is not a renderer: it knows nothing
 //! of materials, lights, cameras or films, and it speaks the typed spaces of `obscura_space` at

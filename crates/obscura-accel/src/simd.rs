@@ -45,19 +45,19 @@ impl Avx2 {
         None
     }
 
-    /// Runs `f` compiled with AVX2 enabled: `f` and everything inlined into it may use the
-    /// eight-lane instructions, and [`slabs8`](Avx2::slabs8) inlines into it.
+    /// Runs `work` inside a function compiled with AVX2 enabled, where [`slabs8`](Avx2::slabs8)
+    /// inlines.
     #[inline(always)]
-    pub(crate) fn run<R>(self, f: impl FnOnce() -> R) -> R {
+    pub(crate) fn run<W: WithAvx2>(self, work: W) -> W::Output {
         #[cfg(target_arch = "x86_64")]
         {
             // SAFETY: `self` exists only if `detect` found AVX2 on this CPU, which is all a
             // function compiled with `target_feature(enable = "avx2")` requires of its caller.
-            unsafe { run_avx2(f) }
+            unsafe { run_avx2(self, work) }
         }
         #[cfg(not(target_arch = "x86_64"))]
         {
-            f()
+            work.with_avx2(self)
         }
     }
 
@@ -93,12 +93,23 @@ impl Avx2 {
     }
 }
 
+/// Work that [`Avx2::run`] compiles for AVX2. Only what is inlined into the AVX2 function is
+/// AVX2 code; a call left out of line runs baseline code. So `with_avx2` and everything it
+/// calls are `#[inline(always)]` functions, which are always inlined, and not closures, which
+/// are inlined only when the optimiser finds them small enough.
+pub(crate) trait WithAvx2 {
+    /// What the work returns.
+    type Output;
+    /// The work, given the token.
+    fn with_avx2(self, avx2: Avx2) -> Self::Output;
+}
+
 /// [`Avx2::run`]'s body, compiled for AVX2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[inline]
-fn run_avx2<R>(f: impl FnOnce() -> R) -> R {
-    f()
+fn run_avx2<W: WithAvx2>(avx2: Avx2, work: W) -> W::Output {
+    work.with_avx2(avx2)
 }
 
 /// [`Avx2::slabs8`], compiled for AVX2 (its intrinsics are safe to call here; it reads memory

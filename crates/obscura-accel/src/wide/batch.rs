@@ -13,11 +13,10 @@
 //! gives for that ray.
 
 use super::layout::{Node, Packet};
-use super::ray::{Level, Portable};
+use super::ray::{Level, OnLevel, dispatch};
 use super::stack::Stack;
 use super::traverse::{Any, Closest, Step, ask};
 use super::{WideBvh, WideHit};
-use crate::simd::Avx2;
 use glam::Vec3A;
 
 /// Rays in flight at once.
@@ -37,7 +36,8 @@ pub(crate) struct BatchRay {
     pub t_max: f32,
 }
 
-/// A query that can take turns with others ([`WideBvh::run`]).
+/// A query that can take turns with others ([`WideBvh::run`]). Its implementations are
+/// `#[inline(always)]`, so that inside [`Avx2::run`] they are compiled for AVX2 too.
 pub(super) trait InTurns: Sized {
     /// What the query answers for a ray.
     type Answer;
@@ -45,8 +45,8 @@ pub(super) trait InTurns: Sized {
     type Entry: Copy + Default;
     /// The query of a ray with `t_min >= 0` from the tree's root.
     fn new(root: u32, r: &BatchRay) -> Self;
-    /// The one-ray query's answer.
-    fn one(bvh: &WideBvh, r: &BatchRay) -> Self::Answer;
+    /// The one-ray query's answer, with the box test of `level`.
+    fn one<L: Level>(bvh: &WideBvh, level: L, r: &BatchRay) -> Self::Answer;
     /// One step with the box test of `level`; the answer once the query has one.
     fn advance<L: Level>(
         &mut self,
@@ -62,12 +62,15 @@ pub(super) trait InTurns: Sized {
 impl InTurns for Closest<false> {
     type Answer = Option<WideHit>;
     type Entry = (u32, f32);
+    #[inline(always)]
     fn new(root: u32, r: &BatchRay) -> Self {
         Closest::new(root, r.o, r.d, r.t_min, r.t_max)
     }
-    fn one(bvh: &WideBvh, r: &BatchRay) -> Self::Answer {
-        bvh.closest(r.o, r.d, r.t_min, r.t_max)
+    #[inline(always)]
+    fn one<L: Level>(bvh: &WideBvh, level: L, r: &BatchRay) -> Self::Answer {
+        bvh.closest_in(level, r.o, r.d, r.t_min, r.t_max, bvh.asks_below())
     }
+    #[inline(always)]
     fn advance<L: Level>(
         &mut self,
         level: L,
@@ -77,6 +80,7 @@ impl InTurns for Closest<false> {
     ) -> Option<Self::Answer> {
         (!self.step::<false, false, L>(level, nodes, packets, stack)).then(|| self.hit(packets))
     }
+    #[inline(always)]
     fn at(&self) -> u32 {
         self.current
     }
@@ -85,12 +89,15 @@ impl InTurns for Closest<false> {
 impl InTurns for Any<false> {
     type Answer = bool;
     type Entry = u32;
+    #[inline(always)]
     fn new(root: u32, r: &BatchRay) -> Self {
         Any::new(root, r.o, r.d, r.t_min, r.t_max)
     }
-    fn one(bvh: &WideBvh, r: &BatchRay) -> Self::Answer {
-        bvh.any(r.o, r.d, r.t_min, r.t_max)
+    #[inline(always)]
+    fn one<L: Level>(bvh: &WideBvh, level: L, r: &BatchRay) -> Self::Answer {
+        bvh.any_in(level, r.o, r.d, r.t_min, r.t_max, bvh.asks_below())
     }
+    #[inline(always)]
     fn advance<L: Level>(
         &mut self,
         level: L,
@@ -104,6 +111,7 @@ impl InTurns for Any<false> {
             Step::Done => Some(false),
         }
     }
+    #[inline(always)]
     fn at(&self) -> u32 {
         self.current
     }
@@ -122,17 +130,21 @@ impl WideBvh {
         self.batch::<Any<false>>(rays, out);
     }
 
-    /// In turns on a large tree (compiled for AVX2 when the CPU has it, as the one-ray
-    /// queries are), one ray after another on a small one.
+    /// The batch compiled for AVX2 when the CPU has it, as the one-ray queries are: the CPU
+    /// is asked once per batch, not once per ray.
     fn batch<Q: InTurns>(&self, rays: &[BatchRay], out: &mut [Q::Answer]) {
+        dispatch(Batch::<Q>(self, rays, out));
+    }
+
+    /// In turns on a large tree, one ray after another on a small one, with the box test of
+    /// `level`.
+    #[inline(always)]
+    fn batch_on<Q: InTurns, L: Level>(&self, level: L, rays: &[BatchRay], out: &mut [Q::Answer]) {
         if self.interleaves() {
-            match Avx2::detect() {
-                Some(avx2) => avx2.run(|| self.run::<Q, _>(avx2, rays, out)),
-                None => self.run::<Q, _>(Portable, rays, out),
-            }
+            self.run::<Q, L>(level, rays, out);
         } else {
             for (r, o) in rays.iter().zip(out) {
-                *o = Q::one(self, r);
+                *o = Q::one(self, level, r);
             }
         }
     }
@@ -158,23 +170,8 @@ impl WideBvh {
         let (nodes, packets) = (&*self.nodes, &*self.packets);
         let mut flights: Vec<Flight<Q>> = Vec::with_capacity(LANES);
         let mut slots = 0..rays.len().min(out.len());
-        // The slot of the next ray that takes turns, answering the others on the way: a ray
-        // that may start behind its origin has the other box test, so it takes the one-ray
-        // query. Only the slot is handed back, so that the lane's query is made in place
-        // rather than made elsewhere and copied in (it holds its prepared ray: hundreds of
-        // bytes).
-        let mut next = |out: &mut [Q::Answer]| {
-            for slot in slots.by_ref() {
-                let r = &rays[slot];
-                if r.t_min >= 0.0 {
-                    return Some(slot);
-                }
-                out[slot] = Q::one(self, r);
-            }
-            None
-        };
         while flights.len() < LANES {
-            match next(out) {
+            match self.next_in_turns::<Q, L>(level, rays, &mut slots, out) {
                 Some(slot) => flights.push((Q::new(self.root, &rays[slot]), slot, Stack::new())),
                 None => break,
             }
@@ -190,7 +187,7 @@ impl WideBvh {
                 };
                 out[*slot] = answer;
                 // The lane's next ray takes over its query and its (emptied) stack in place.
-                match next(out) {
+                match self.next_in_turns::<Q, L>(level, rays, &mut slots, out) {
                     Some(fresh) => {
                         *q = Q::new(self.root, &rays[fresh]);
                         *slot = fresh;
@@ -203,6 +200,70 @@ impl WideBvh {
                 }
             }
         }
+    }
+}
+
+impl WideBvh {
+    /// The slot of the next ray of `slots` that takes turns, answering the others on the way:
+    /// a ray that may start behind its origin has the other box test, so it takes the one-ray
+    /// query. Only the slot is handed back, so that the lane's query is made in place rather
+    /// than made elsewhere and copied in (it holds its prepared ray: hundreds of bytes). A
+    /// function, not a closure, so that it is always inlined ([`crate::simd::WithAvx2`]).
+    #[inline(always)]
+    fn next_in_turns<Q: InTurns, L: Level>(
+        &self,
+        level: L,
+        rays: &[BatchRay],
+        slots: &mut std::ops::Range<usize>,
+        out: &mut [Q::Answer],
+    ) -> Option<usize> {
+        for slot in slots.by_ref() {
+            let r = &rays[slot];
+            if r.t_min >= 0.0 {
+                return Some(slot);
+            }
+            out[slot] = Q::one(self, level, r);
+        }
+        None
+    }
+}
+
+/// One ray's query `Q` ([`InTurns::one`]), for [`dispatch`].
+pub(super) struct One<'a, Q> {
+    bvh: &'a WideBvh,
+    ray: BatchRay,
+    query: std::marker::PhantomData<Q>,
+}
+
+impl<'a, Q> One<'a, Q> {
+    /// The query `Q` of `ray` in `bvh`.
+    #[inline(always)]
+    pub(super) fn new(bvh: &'a WideBvh, ray: BatchRay) -> Self {
+        One {
+            bvh,
+            ray,
+            query: std::marker::PhantomData,
+        }
+    }
+}
+
+impl<Q: InTurns> OnLevel for One<'_, Q> {
+    type Output = Q::Answer;
+    #[inline(always)]
+    fn on<L: Level>(self, level: L) -> Q::Answer {
+        Q::one(self.bvh, level, &self.ray)
+    }
+}
+
+/// A batch of query `Q`, its rays and where their answers go, for [`dispatch`].
+struct Batch<'a, Q: InTurns>(&'a WideBvh, &'a [BatchRay], &'a mut [Q::Answer]);
+
+impl<Q: InTurns> OnLevel for Batch<'_, Q> {
+    type Output = ();
+    #[inline(always)]
+    fn on<L: Level>(self, level: L) {
+        let Batch(bvh, rays, out) = self;
+        bvh.batch_on::<Q, L>(level, rays, out);
     }
 }
 

@@ -3,7 +3,7 @@
 
 use super::layout::{ARITY, Node, Packet, WIDTH};
 use crate::geom::gamma;
-use crate::simd::Avx2;
+use crate::simd::{Avx2, WithAvx2};
 use glam::{BVec4A, Vec3A, Vec4};
 
 /// pbrt's `gamma(3)`: the relative error of a slab distance `(b - o) * (1 / d)`; the far
@@ -163,6 +163,36 @@ pub(super) trait Level: Copy {
             ),
             None => ray.slabs::<ARITY>(node, t_min, t_max),
         }
+    }
+}
+
+/// A query to run with the best box test this CPU has ([`dispatch`]); `on` is
+/// `#[inline(always)]`, as [`WithAvx2`] requires.
+pub(super) trait OnLevel {
+    /// What the query returns.
+    type Output;
+    /// The query with the box test of `level`.
+    fn on<L: Level>(self, level: L) -> Self::Output;
+}
+
+/// A query handed to [`Avx2::run`], which runs it with the AVX2 box test.
+struct OnAvx2<Q>(Q);
+
+impl<Q: OnLevel> WithAvx2 for OnAvx2<Q> {
+    type Output = Q::Output;
+    #[inline(always)]
+    fn with_avx2(self, avx2: Avx2) -> Q::Output {
+        self.0.on(avx2)
+    }
+}
+
+/// Runs `query` compiled for AVX2 with the eight-lane box test when the CPU has AVX2, and with
+/// the portable test otherwise.
+#[inline(always)]
+pub(super) fn dispatch<Q: OnLevel>(query: Q) -> Q::Output {
+    match Avx2::detect() {
+        Some(avx2) => avx2.run(OnAvx2(query)),
+        None => query.on(Portable),
     }
 }
 

@@ -1,11 +1,12 @@
 //! The queries: front-to-back closest hit and any hit, each over a per-thread stack.
 
+use super::batch::{BatchRay, One};
 use super::layout::{ARITY, EMPTY, INDEX, LEAF, Node, PAIR, Packet};
-use super::ray::{Level, Portable, Prepared, by_entry};
+use super::ray::{Level, Prepared, by_entry, dispatch};
 use super::stack::Stack;
 use super::{WideBvh, WideHit};
 use crate::geom::TriangleHit;
-use crate::simd::{Avx2, prefetch, prefetch_items};
+use crate::simd::{prefetch, prefetch_items};
 use glam::{Vec3, Vec3A, Vec4};
 use std::cell::Cell;
 
@@ -19,20 +20,22 @@ thread_local! {
     static ANY_STACK: Kept<u32> = const { Cell::new(None) };
 }
 
-/// Runs `query` with this thread's (emptied) stack from `key`. The stack is taken, not
-/// borrowed, so a nested query (none today) would simply get a fresh one.
+/// This thread's stack from `key`, emptied. It is taken, not borrowed, so a nested query (none
+/// today) would simply get a fresh one; [`keep`] hands it back. The queries run between the
+/// two rather than in a closure given to the thread-local's `with`: code that
+/// [`Avx2::run`] compiles for AVX2 must be inlined into it, and a large closure called from
+/// more than one place may not be.
 #[inline(always)]
-fn with_stack<T: Copy + Default, R>(
-    key: &'static std::thread::LocalKey<Kept<T>>,
-    query: impl FnOnce(&mut Stack<T>) -> R,
-) -> R {
-    key.with(|cell| {
-        let mut stack = cell.take().unwrap_or_default();
-        stack.clear();
-        let result = query(&mut stack);
-        cell.set(Some(stack));
-        result
-    })
+fn take<T: Copy + Default>(key: &'static std::thread::LocalKey<Kept<T>>) -> Box<Stack<T>> {
+    let mut stack = key.with(Cell::take).unwrap_or_default();
+    stack.clear();
+    stack
+}
+
+/// Hands a stack from [`take`] back to this thread's `key` for the next query.
+#[inline(always)]
+fn keep<T>(key: &'static std::thread::LocalKey<Kept<T>>, stack: Box<Stack<T>>) {
+    key.with(|cell| cell.set(Some(stack)));
 }
 
 impl WideBvh {
@@ -40,22 +43,20 @@ impl WideBvh {
     /// has it ([`Avx2`]).
     #[inline]
     pub(crate) fn closest(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> Option<WideHit> {
-        let below = self.asks_below();
-        match Avx2::detect() {
-            Some(avx2) => avx2.run(|| self.closest_in(avx2, o, d, t_min, t_max, below)),
-            None => self.closest_in(Portable, o, d, t_min, t_max, below),
-        }
+        dispatch(One::<Closest<false>>::new(
+            self,
+            BatchRay { o, d, t_min, t_max },
+        ))
     }
 
     /// True when any triangle is hit with `t` in `[t_min, t_max]`; stops at the first found.
     /// Compiled for AVX2 when the CPU has it, as [`closest`](WideBvh::closest) is.
     #[inline]
     pub(crate) fn any(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> bool {
-        let below = self.asks_below();
-        match Avx2::detect() {
-            Some(avx2) => avx2.run(|| self.any_in(avx2, o, d, t_min, t_max, below)),
-            None => self.any_in(Portable, o, d, t_min, t_max, below),
-        }
+        dispatch(One::<Any<false>>::new(
+            self,
+            BatchRay { o, d, t_min, t_max },
+        ))
     }
 
     /// [`closest`](WideBvh::closest) with the box test of `level` on this thread's stack, its
@@ -72,12 +73,16 @@ impl WideBvh {
         t_max: f32,
         below: bool,
     ) -> Option<WideHit> {
-        with_stack(&CLOSEST_STACK, |stack| match (t_min >= 0.0, below) {
-            (true, false) => self.closest_with::<false, false, L>(level, stack, o, d, t_min, t_max),
-            (true, true) => self.closest_with::<false, true, L>(level, stack, o, d, t_min, t_max),
-            (false, false) => self.closest_with::<true, false, L>(level, stack, o, d, t_min, t_max),
-            (false, true) => self.closest_with::<true, true, L>(level, stack, o, d, t_min, t_max),
-        })
+        let mut stack = take(&CLOSEST_STACK);
+        let s = &mut stack;
+        let hit = match (t_min >= 0.0, below) {
+            (true, false) => self.closest_with::<false, false, L>(level, s, o, d, t_min, t_max),
+            (true, true) => self.closest_with::<false, true, L>(level, s, o, d, t_min, t_max),
+            (false, false) => self.closest_with::<true, false, L>(level, s, o, d, t_min, t_max),
+            (false, true) => self.closest_with::<true, true, L>(level, s, o, d, t_min, t_max),
+        };
+        keep(&CLOSEST_STACK, stack);
+        hit
     }
 
     /// [`any`](WideBvh::any) with the box test of `level`, chosen as
@@ -92,18 +97,22 @@ impl WideBvh {
         t_max: f32,
         below: bool,
     ) -> bool {
-        with_stack(&ANY_STACK, |stack| match (t_min >= 0.0, below) {
-            (true, false) => self.any_with::<false, false, L>(level, stack, o, d, t_min, t_max),
-            (true, true) => self.any_with::<false, true, L>(level, stack, o, d, t_min, t_max),
-            (false, false) => self.any_with::<true, false, L>(level, stack, o, d, t_min, t_max),
-            (false, true) => self.any_with::<true, true, L>(level, stack, o, d, t_min, t_max),
-        })
+        let mut stack = take(&ANY_STACK);
+        let s = &mut stack;
+        let answer = match (t_min >= 0.0, below) {
+            (true, false) => self.any_with::<false, false, L>(level, s, o, d, t_min, t_max),
+            (true, true) => self.any_with::<false, true, L>(level, s, o, d, t_min, t_max),
+            (false, false) => self.any_with::<true, false, L>(level, s, o, d, t_min, t_max),
+            (false, true) => self.any_with::<true, true, L>(level, s, o, d, t_min, t_max),
+        };
+        keep(&ANY_STACK, stack);
+        answer
     }
 
     /// Whether a one-ray query asks for a node's leaf packets and first child node at its
     /// visit ([`ask_below`]): only on a tree of [`ASK_BELOW_MIN_BYTES`] or more.
     #[inline(always)]
-    fn asks_below(&self) -> bool {
+    pub(super) fn asks_below(&self) -> bool {
         self.heap_bytes() >= ASK_BELOW_MIN_BYTES
     }
 
